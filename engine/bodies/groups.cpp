@@ -1,0 +1,129 @@
+// Stage `groups`: rigid groups (PFC clumps, model.md 1). Members' forces were summed by the
+// gather; here they are reduced to a force and a torque about the centre of mass, each degree of
+// freedom is advanced according to its mode (free: leapfrog with local damping; fixed;
+// velocity-prescribed), and the members are moved rigidly.
+//
+// Energy (model.md 8): the agent that holds a fixed or prescribed degree of freedom does the work
+// needed to make the group follow its prescription, F_agent = M dV/dt - F; that work is boundary
+// work. Gyroscopic terms of free rotation are neglected (quasi-static loading).
+#include <cmath>
+
+#include <Eigen/Dense>
+
+#include "state.hpp"
+
+namespace asperity::detail {
+
+namespace {
+inline double sign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
+
+// Rotation of r by the rotation vector theta (Rodrigues).
+Vec3 rotate(const Vec3& r, const Vec3& theta) {
+  const double a = norm(theta);
+  if (a == 0) return r;
+  const Vec3 k = theta / a;
+  const double c = std::cos(a), s = std::sin(a);
+  return r * c + cross(k, r) * s + k * (dot(k, r) * (1 - c));
+}
+}  // namespace
+
+void advance_groups(State& s) {
+  ParticleStore& p = s.p;
+  const double dt = s.dt, alpha = s.settings.local_damping;
+  const Vec3 g = s.settings.gravity;
+  double kinetic = 0;
+  for (Group& grp : s.groups) {
+    if (grp.members.empty()) continue;
+    Vec3 F = grp.applied, T{0, 0, 0};
+    for (std::int32_t i : grp.members) {
+      const Vec3 f{p.fx[i], p.fy[i], p.fz[i]};
+      const Vec3 r = Vec3{p.x[i], p.y[i], p.z[i]} - grp.centre;
+      F += f;
+      T += Vec3{p.tx[i], p.ty[i], p.tz[i]} + cross(r, f);
+    }
+    grp.force = F;
+    grp.torque = T;
+    const double M = grp.mass;
+
+    // Translation, per axis.
+    double V[3] = {grp.velocity.x, grp.velocity.y, grp.velocity.z};
+    const double Fk[3] = {F.x, F.y, F.z}, gk[3] = {g.x, g.y, g.z};
+    const double Vp[3] = {grp.motion.velocity.x, grp.motion.velocity.y, grp.motion.velocity.z};
+    double Vn[3] = {0, 0, 0};
+    double agent_work = 0, damping_work = 0;
+    for (int k = 0; k < 3; ++k) {
+      switch (grp.motion.translation[k]) {
+        case Dof::free: {
+          const double fd = -alpha * std::fabs(Fk[k]) * sign(V[k]);
+          Vn[k] = V[k] + (Fk[k] + fd) / M * dt + gk[k] * dt;
+          damping_work -= fd * 0.5 * (V[k] + Vn[k]) * dt;
+          break;
+        }
+        case Dof::fixed:
+        case Dof::velocity: {
+          Vn[k] = grp.motion.translation[k] == Dof::fixed ? 0.0 : Vp[k];
+          const double agent = M * (Vn[k] - V[k]) / dt - (Fk[k] + M * gk[k]);
+          agent_work += agent * 0.5 * (V[k] + Vn[k]) * dt;
+          break;
+        }
+      }
+    }
+    const Vec3 Vnew{Vn[0], Vn[1], Vn[2]};
+    const Vec3 Vmid = (grp.velocity + Vnew) * 0.5;
+
+    // Rotation, all axes together.
+    Vec3 W = grp.angular_velocity, Wnew{0, 0, 0};
+    if (grp.motion.rotation == Dof::fixed) {
+      Wnew = {0, 0, 0};
+    } else {
+      Eigen::Matrix3d I = Eigen::Matrix3d::Zero();
+      for (std::int32_t i : grp.members) {
+        const Eigen::Vector3d r(p.x[i] - grp.centre.x, p.y[i] - grp.centre.y, p.z[i] - grp.centre.z);
+        I += p.mass[i] * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose()) +
+             p.inertia[i] * Eigen::Matrix3d::Identity();
+      }
+      if (grp.motion.rotation == Dof::velocity) {
+        Wnew = grp.motion.angular_velocity;
+        const Eigen::Vector3d dW(Wnew.x - W.x, Wnew.y - W.y, Wnew.z - W.z);
+        const Eigen::Vector3d agent = I * dW / dt - Eigen::Vector3d(T.x, T.y, T.z);
+        agent_work += Vec3{agent.x(), agent.y(), agent.z()} == Vec3{} ? 0.0
+                      : dot(Vec3{agent.x(), agent.y(), agent.z()}, (W + Wnew) * 0.5) * dt;
+      } else {
+        const Vec3 Td{-alpha * std::fabs(T.x) * sign(W.x), -alpha * std::fabs(T.y) * sign(W.y),
+                      -alpha * std::fabs(T.z) * sign(W.z)};
+        const Eigen::Vector3d dW = I.ldlt().solve(Eigen::Vector3d(T.x + Td.x, T.y + Td.y, T.z + Td.z)) * dt;
+        Wnew = W + Vec3{dW.x(), dW.y(), dW.z()};
+        damping_work -= dot(Td, (W + Wnew) * 0.5) * dt;
+      }
+    }
+
+    if (s.settings.track_energy) {
+      s.ledger.boundary += agent_work + dot(grp.applied, Vmid) * dt;
+      s.ledger.damping += damping_work;
+      s.ledger.gravity += M * dot(g, Vmid) * dt;
+    }
+
+    // Move the members rigidly.
+    const Vec3 old_centre = grp.centre;
+    grp.centre += Vnew * dt;
+    grp.velocity = Vnew;
+    grp.angular_velocity = Wnew;
+    const Vec3 theta = Wnew * dt;
+    const bool spins = !(Wnew == Vec3{});
+    for (std::int32_t i : grp.members) {
+      Vec3 r = Vec3{p.x[i], p.y[i], p.z[i]} - old_centre;
+      if (spins) r = rotate(r, theta);
+      const Vec3 x = grp.centre + r;
+      const Vec3 v = Vnew + cross(Wnew, r);
+      const Vec3 vmid = (v + Vec3{p.vx[i], p.vy[i], p.vz[i]}) * 0.5;
+      const Vec3 wmid = (Wnew + W) * 0.5;
+      kinetic += 0.5 * p.mass[i] * dot(vmid, vmid) + 0.5 * p.inertia[i] * dot(wmid, wmid);
+      p.x[i] = x.x; p.y[i] = x.y; p.z[i] = x.z;
+      p.vx[i] = v.x; p.vy[i] = v.y; p.vz[i] = v.z;
+      p.wx[i] = Wnew.x; p.wy[i] = Wnew.y; p.wz[i] = Wnew.z;
+    }
+  }
+  s.kinetic_at_step = kinetic;  // the free particles' share is added in bookkeeping
+}
+
+}  // namespace asperity::detail

@@ -1,0 +1,32 @@
+// Scalar reference of the pair kernel: one pair at a time, plain doubles. It is the definition
+// the SIMD kernels are tested against, and what a build without SIMD runs.
+#include "kernels/pair_loop.hpp"
+
+namespace asperity::kernels {
+namespace {
+
+struct ScalarLanes {
+  using Real = double;
+  static constexpr std::size_t size = 1;
+  static std::int64_t index(const std::int64_t* p) { return *p; }
+  static double gather(const double* col, std::int64_t i) { return col[i]; }
+  static double load(const double* p) { return *p; }
+  static void store(double* p, double v) { *p = v; }
+  static double sum(double v) { return v; }
+};
+
+double pair_rot(const PairKernelArgs& k, std::size_t b, std::size_t e) {
+  return pair_loop<ScalarLanes, true>(k, b, e);
+}
+double pair_norot(const PairKernelArgs& k, std::size_t b, std::size_t e) {
+  return pair_loop<ScalarLanes, false>(k, b, e);
+}
+
+}  // namespace
+
+const KernelSet& scalar_kernels() {
+  static const KernelSet set{"scalar", 1, &pair_rot, &pair_norot};
+  return set;
+}
+
+}  // namespace asperity::kernels

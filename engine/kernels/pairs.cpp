@@ -1,0 +1,33 @@
+// Stage `contacts`: run the selected pair kernel over fixed blocks of the pair list.
+#include "state.hpp"
+
+namespace asperity::detail {
+
+kernels::PairKernelArgs pair_kernel_args(State& s) {
+  ParticleStore& p = s.p;
+  PairStore& q = s.pairs;
+  const ContactMaterial& m = s.settings.contact;
+  return {p.x.data(), p.y.data(), p.z.data(), p.vx.data(), p.vy.data(), p.vz.data(),
+          p.wx.data(), p.wy.data(), p.wz.data(), p.radius.data(), q.a.data(), q.b.data(),
+          q.nx.data(), q.ny.data(), q.nz.data(), q.fsx.data(), q.fsy.data(), q.fsz.data(),
+          q.fn.data(), q.overlap.data(), m.kn, m.ks, m.friction, s.dt};
+}
+
+void compute_pair_forces(State& s) {
+  const auto args = pair_kernel_args(s);
+  const auto kernel = s.settings.rotation ? s.kernels->pair : s.kernels->pair_norot;
+  const std::size_t total = s.pairs.padded;
+  const std::size_t blocks = (total + kPairBlock - 1) / kPairBlock;
+  s.pair_block_slip.assign(blocks, 0.0);
+  double* slip = s.pair_block_slip.data();
+#pragma omp parallel for schedule(static) num_threads(thread_count(s))
+  for (std::size_t blk = 0; blk < blocks; ++blk) {
+    const std::size_t begin = blk * kPairBlock;
+    const std::size_t end = std::min(total, begin + kPairBlock);
+    slip[blk] = kernel(args, begin, end);
+  }
+  if (s.settings.track_energy)
+    for (std::size_t blk = 0; blk < blocks; ++blk) s.ledger.friction += slip[blk];
+}
+
+}  // namespace asperity::detail

@@ -1,0 +1,46 @@
+// SIMD pair kernel, compiled once per instruction set (engine/CMakeLists.txt passes
+// ASPERITY_SIMD_ARCH and the matching -m flag). Same loop and law as the scalar reference; only
+// the loads and stores differ: gathers of the particle columns by pair index, aligned loads and
+// stores of the pair columns (blocks start at multiples of kMaxLanes on 64-byte aligned columns).
+#include <xsimd/xsimd.hpp>
+
+#include "kernels/pair_loop.hpp"
+
+#define ASPERITY_CAT2(a, b) a##b
+#define ASPERITY_CAT(a, b) ASPERITY_CAT2(a, b)
+
+namespace asperity::kernels {
+namespace {
+
+using Arch = xsimd::ASPERITY_SIMD_ARCH;
+
+struct SimdLanes {
+  using Real = xsimd::batch<double, Arch>;
+  using Index = xsimd::batch<std::int64_t, Arch>;
+  static constexpr std::size_t size = Real::size;
+  static Index index(const std::int64_t* p) { return Index::load_aligned(p); }
+  static Real gather(const double* col, const Index& i) { return Real::gather(col, i); }
+  static Real load(const double* p) { return Real::load_aligned(p); }
+  static void store(double* p, const Real& v) { v.store_aligned(p); }
+  static double sum(const Real& v) { return xsimd::hadd(v); }
+};
+
+double pair_rot(const PairKernelArgs& k, std::size_t b, std::size_t e) {
+  return pair_loop<SimdLanes, true>(k, b, e);
+}
+double pair_norot(const PairKernelArgs& k, std::size_t b, std::size_t e) {
+  return pair_loop<SimdLanes, false>(k, b, e);
+}
+
+}  // namespace
+
+#define ASPERITY_STR2(a) #a
+#define ASPERITY_STR(a) ASPERITY_STR2(a)
+
+const KernelSet& ASPERITY_CAT(kernels_, ASPERITY_SIMD_ARCH)() {
+  static const KernelSet set{ASPERITY_STR(ASPERITY_SIMD_ARCH), SimdLanes::size, &pair_rot,
+                             &pair_norot};
+  return set;
+}
+
+}  // namespace asperity::kernels

@@ -1,0 +1,195 @@
+// Stage `walls`: ball-wall contacts (planes and triangle meshes) with the same contact law as
+// ball-ball pairs (model.md 4), the wall in the role of body a: it translates with its prescribed
+// velocity and does not spin. Scalar: wall contacts are a surface term, few next to the pairs.
+//
+// Also here: the triangle geometry (closest point with its feature, binning, queries).
+#include <algorithm>
+#include <cmath>
+
+#include "kernels/contact_law.hpp"
+#include "state.hpp"
+
+namespace asperity::detail {
+
+Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
+                               int& feature) {
+  // Voronoi regions of the triangle's features, tested in turn (barycentric reasoning).
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) { feature = 1; return a; }
+  const Vec3 bp = p - b;
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) { feature = 2; return b; }
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) { feature = 4; return a + ab * (d1 / (d1 - d3)); }
+  const Vec3 cp = p - c;
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) { feature = 3; return c; }
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) { feature = 6; return a + ac * (d2 / (d2 - d6)); }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    feature = 5;
+    return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  }
+  feature = 0;
+  const double denom = 1.0 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+void bin_mesh(Mesh& mesh) {
+  TriangleBins& g = mesh.bins;
+  Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  double edge_sum = 0;
+  for (const auto& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const Vec3& v = mesh.vertices[t[k]];
+      lo = {std::min(lo.x, v.x), std::min(lo.y, v.y), std::min(lo.z, v.z)};
+      hi = {std::max(hi.x, v.x), std::max(hi.y, v.y), std::max(hi.z, v.z)};
+      edge_sum += norm(mesh.vertices[t[(k + 1) % 3]] - v);
+    }
+  }
+  const double mean_edge = mesh.triangles.empty() ? 1.0 : edge_sum / (3.0 * mesh.triangles.size());
+  g.cell = std::max(2.0 * mean_edge, 1e-12);
+  const Vec3 ext = hi - lo;
+  auto dim = [&](double e) { return std::max(1, int(std::min(4096.0, std::ceil(e / g.cell)))); };
+  while (double(dim(ext.x)) * dim(ext.y) * dim(ext.z) > 4.0 * mesh.triangles.size() + 64) g.cell *= 1.26;
+  g.origin = lo;
+  g.dims = {dim(ext.x), dim(ext.y), dim(ext.z)};
+  const std::size_t cells = std::size_t(g.dims[0]) * g.dims[1] * g.dims[2];
+  auto cell_range = [&](const Vec3& mn, const Vec3& mx, int (&r)[3][2]) {
+    const double lo3[3] = {mn.x - g.origin.x, mn.y - g.origin.y, mn.z - g.origin.z};
+    const double hi3[3] = {mx.x - g.origin.x, mx.y - g.origin.y, mx.z - g.origin.z};
+    for (int d = 0; d < 3; ++d) {
+      r[d][0] = std::clamp(int(std::floor(lo3[d] / g.cell)), 0, g.dims[d] - 1);
+      r[d][1] = std::clamp(int(std::floor(hi3[d] / g.cell)), 0, g.dims[d] - 1);
+    }
+  };
+  std::vector<std::int32_t> count(cells + 1, 0);
+  std::vector<std::array<int, 6>> ranges(mesh.triangles.size());
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& tri = mesh.triangles[t];
+    Vec3 mn = mesh.vertices[tri[0]], mx = mn;
+    for (int k = 1; k < 3; ++k) {
+      const Vec3& v = mesh.vertices[tri[k]];
+      mn = {std::min(mn.x, v.x), std::min(mn.y, v.y), std::min(mn.z, v.z)};
+      mx = {std::max(mx.x, v.x), std::max(mx.y, v.y), std::max(mx.z, v.z)};
+    }
+    int r[3][2];
+    cell_range(mn, mx, r);
+    ranges[t] = {r[0][0], r[0][1], r[1][0], r[1][1], r[2][0], r[2][1]};
+    for (int k = r[2][0]; k <= r[2][1]; ++k)
+      for (int j = r[1][0]; j <= r[1][1]; ++j)
+        for (int i = r[0][0]; i <= r[0][1]; ++i)
+          ++count[(std::size_t(k) * g.dims[1] + j) * g.dims[0] + i + 1];
+  }
+  for (std::size_t c = 0; c < cells; ++c) count[c + 1] += count[c];
+  g.start = count;
+  g.triangles.resize(count[cells]);
+  std::vector<std::int32_t> fill(count.begin(), count.end() - 1);
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& r = ranges[t];
+    for (int k = r[4]; k <= r[5]; ++k)
+      for (int j = r[2]; j <= r[3]; ++j)
+        for (int i = r[0]; i <= r[1]; ++i)
+          g.triangles[fill[(std::size_t(k) * g.dims[1] + j) * g.dims[0] + i]++] = std::int32_t(t);
+  }
+}
+
+void query_mesh(const Mesh& mesh, const Vec3& q, double reach, std::vector<std::int32_t>& out) {
+  out.clear();
+  const TriangleBins& g = mesh.bins;
+  int r[3][2];
+  const double c[3] = {q.x - g.origin.x, q.y - g.origin.y, q.z - g.origin.z};
+  for (int d = 0; d < 3; ++d) {
+    const double lo = (c[d] - reach) / g.cell, hi = (c[d] + reach) / g.cell;
+    if (hi < 0 || lo >= g.dims[d]) return;  // the sphere's box misses the mesh's box
+    r[d][0] = std::clamp(int(std::floor(lo)), 0, g.dims[d] - 1);
+    r[d][1] = std::clamp(int(std::floor(hi)), 0, g.dims[d] - 1);
+  }
+  for (int k = r[2][0]; k <= r[2][1]; ++k)
+    for (int j = r[1][0]; j <= r[1][1]; ++j)
+      for (int i = r[0][0]; i <= r[0][1]; ++i) {
+        const std::size_t cell = (std::size_t(k) * g.dims[1] + j) * g.dims[0] + i;
+        out.insert(out.end(), g.triangles.begin() + g.start[cell],
+                   g.triangles.begin() + g.start[cell + 1]);
+      }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
+namespace {
+// Feature code -> ownership bit (see Mesh::owns).
+constexpr std::uint8_t kFeatureBit[7] = {0, 1 << 3, 1 << 4, 1 << 5, 1 << 0, 1 << 1, 1 << 2};
+}  // namespace
+
+void compute_wall_forces(State& s) {
+  ParticleStore& p = s.p;
+  WallContacts& wc = s.walls.contacts;
+  auto& walls = s.walls.walls;
+  const std::size_t nw = walls.size();
+  const std::size_t blocks = (wc.n + kParticleBlock - 1) / kParticleBlock;
+  // Per block: slip energy, boundary work, and the force on each wall.
+  std::vector<double> slip(blocks, 0.0), work(blocks, 0.0);
+  std::vector<Vec3> force(blocks * nw);
+  const double dt = s.dt;
+  const bool rot = s.settings.rotation;
+#pragma omp parallel for schedule(static) num_threads(thread_count(s))
+  for (std::size_t blk = 0; blk < blocks; ++blk) {
+    const std::size_t end = std::min(wc.n, (blk + 1) * kParticleBlock);
+    for (std::size_t k = blk * kParticleBlock; k < end; ++k) {
+      const std::int32_t i = wc.particle[k];
+      const Wall& wall = walls[wc.wall[k]];
+      const Vec3 c{p.x[i], p.y[i], p.z[i]};
+      Vec3 n;
+      double U;
+      bool active = true;
+      if (wall.kind == Wall::Kind::plane) {
+        const double d = dot(c - (wall.point + wall.displacement), wall.normal);
+        n = wall.normal;
+        U = p.radius[i] - d;
+      } else {
+        const Mesh& mesh = s.walls.meshes[wall.mesh];
+        const auto& tri = mesh.triangles[wc.facet[k]];
+        int feature;
+        const Vec3 q = c - wall.displacement;
+        const Vec3 cp = closest_point_on_triangle(q, mesh.vertices[tri[0]], mesh.vertices[tri[1]],
+                                                  mesh.vertices[tri[2]], feature);
+        const Vec3 dv = q - cp;
+        const double d = norm(dv);
+        n = d > 0 ? dv / d : Vec3{0, 0, 1};
+        U = p.radius[i] - d;
+        active = feature == 0 || (mesh.owns[wc.facet[k]] & kFeatureBit[feature]);
+      }
+      if (!active) U = -1.0;  // not this triangle's contact: no force, history dropped
+      Vec3 o{wc.nx[k], wc.ny[k], wc.nz[k]};
+      if (dot(o, o) == 0) o = n;
+      double fx = wc.fsx[k], fy = wc.fsy[k], fz = wc.fsz[k], fn;
+      const double lb = p.radius[i] - 0.5 * U;
+      const double wx = rot ? p.wx[i] : 0.0, wy = rot ? p.wy[i] : 0.0, wz = rot ? p.wz[i] : 0.0;
+      const kernels::LawParams<double> law{wall.material.kn, wall.material.ks,
+                                           wall.material.friction, dt};
+      slip[blk] += kernels::contact_forces(n.x, n.y, n.z, U, 0.0, lb, wall.velocity.x,
+                                           wall.velocity.y, wall.velocity.z, 0.0, 0.0, 0.0,
+                                           p.vx[i], p.vy[i], p.vz[i], wx, wy, wz, o.x, o.y, o.z,
+                                           fx, fy, fz, fn, law);
+      wc.nx[k] = n.x; wc.ny[k] = n.y; wc.nz[k] = n.z;
+      wc.fsx[k] = fx; wc.fsy[k] = fy; wc.fsz[k] = fz;
+      wc.fn[k] = fn;
+      wc.overlap[k] = U;
+      const Vec3 f{fn * n.x + fx, fn * n.y + fy, fn * n.z + fz};  // on the particle
+      force[blk * nw + wc.wall[k]] -= f;
+      work[blk] += dot(f, wall.velocity) * dt;  // model.md 8: boundary work of the wall
+    }
+  }
+  for (auto& w : walls) w.force = {0, 0, 0};
+  for (std::size_t blk = 0; blk < blocks; ++blk) {
+    for (std::size_t w = 0; w < nw; ++w) walls[w].force += force[blk * nw + w];
+    if (s.settings.track_energy) {
+      s.ledger.friction += slip[blk];
+      s.ledger.boundary += work[blk];
+    }
+  }
+}
+
+}  // namespace asperity::detail

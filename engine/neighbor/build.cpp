@@ -1,0 +1,360 @@
+// Neighbour search (model.md 6): linked cells, a Verlet list with a skin, history carried across
+// rebuilds, and a periodic reorder of the particles along a Morton (Z-order) curve.
+//
+// Design notes
+// - Pairs are keyed by current indices (a < b) and kept sorted. Between two rebuilds without a
+//   reorder the indices do not change, so the old and new sorted lists merge in one linear walk
+//   and every surviving pair gets its normal and shear force back exactly. A reorder renumbers the
+//   old list first (swapping a and b, and negating the history vectors, where the order flips)
+//   and re-sorts it. This keeps the pair list in the particles' memory order (good locality for
+//   the gathers) while carrying history as exactly as keying by stable ids would.
+// - The list is built particle by particle (each particle i lists its j > i in its 27 cells,
+//   sorted), counted first and filled second, so it is the same for any thread count.
+// - Pairs of two members of one rigid group are never listed.
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "state.hpp"
+
+namespace asperity::detail {
+
+namespace {
+
+struct CellGrid {
+  double ox = 0, oy = 0, oz = 0, cell = 1;
+  int nx = 1, ny = 1, nz = 1;
+  std::vector<std::int32_t> cell_of;   // per particle
+  std::vector<std::int32_t> start;     // per cell + 1
+  std::vector<std::int32_t> members;   // particle indices, by cell, ascending within a cell
+
+  int clampi(double v, int n) const {
+    int i = static_cast<int>(std::floor(v / cell));
+    return std::clamp(i, 0, n - 1);
+  }
+  void coords(double x, double y, double z, int& i, int& j, int& k) const {
+    i = clampi(x - ox, nx);
+    j = clampi(y - oy, ny);
+    k = clampi(z - oz, nz);
+  }
+};
+
+CellGrid make_grid(const ParticleStore& p, double skin) {
+  CellGrid g;
+  const std::size_t n = p.n;
+  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, rmax = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double c[3] = {p.x[i], p.y[i], p.z[i]};
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = std::min(lo[d], c[d]);
+      hi[d] = std::max(hi[d], c[d]);
+    }
+    rmax = std::max(rmax, p.radius[i]);
+  }
+  // Cell edge >= the largest Ra + Rb + skin, so a pair within reach is in adjacent cells.
+  g.cell = std::max(2 * rmax + skin, 1e-12);
+  // A sparse scene would make the grid huge: grow the cells until there are at most ~2 per
+  // particle (the search stays correct with larger cells, only less selective).
+  auto dims = [&](double cell, int d) {
+    return static_cast<int>(std::min(1e6, std::floor((hi[d] - lo[d]) / cell) + 1));
+  };
+  while (double(dims(g.cell, 0)) * dims(g.cell, 1) * dims(g.cell, 2) > 2.0 * double(n) + 64)
+    g.cell *= 1.26;
+  g.ox = lo[0];
+  g.oy = lo[1];
+  g.oz = lo[2];
+  g.nx = dims(g.cell, 0);
+  g.ny = dims(g.cell, 1);
+  g.nz = dims(g.cell, 2);
+  const std::size_t cells = std::size_t(g.nx) * g.ny * g.nz;
+  g.cell_of.resize(n);
+  g.start.assign(cells + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    int a, b, c;
+    g.coords(p.x[i], p.y[i], p.z[i], a, b, c);
+    g.cell_of[i] = static_cast<std::int32_t>((std::size_t(c) * g.ny + b) * g.nx + a);
+    ++g.start[g.cell_of[i] + 1];
+  }
+  std::partial_sum(g.start.begin(), g.start.end(), g.start.begin());
+  g.members.resize(n);
+  std::vector<std::int32_t> fill(g.start.begin(), g.start.end() - 1);
+  for (std::size_t i = 0; i < n; ++i) g.members[fill[g.cell_of[i]]++] = std::int32_t(i);
+  return g;
+}
+
+std::uint64_t spread_bits(std::uint64_t v) {  // 21 bits -> every third bit
+  v &= 0x1fffff;
+  v = (v | v << 32) & 0x1f00000000ffffULL;
+  v = (v | v << 16) & 0x1f0000ff0000ffULL;
+  v = (v | v << 8) & 0x100f00f00f00f00fULL;
+  v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+  v = (v | v << 2) & 0x1249249249249249ULL;
+  return v;
+}
+
+// Renumber particles along the Morton curve of their cells, and every index that refers to them.
+void reorder(State& s, const CellGrid& g) {
+  ParticleStore& p = s.p;
+  const std::size_t n = p.n;
+  std::vector<std::uint64_t> code(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    int a, b, c;
+    g.coords(p.x[i], p.y[i], p.z[i], a, b, c);
+    code[i] = spread_bits(a) | spread_bits(b) << 1 | spread_bits(c) << 2;
+  }
+  std::vector<std::int32_t> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::int32_t u, std::int32_t v) { return code[u] < code[v]; });
+  std::vector<std::int64_t> new_index(p.capacity);
+  std::iota(new_index.begin(), new_index.end(), 0);  // null particles keep their place
+  for (std::size_t i = 0; i < n; ++i) new_index[order[i]] = std::int64_t(i);
+  p.permute(order);
+
+  // Old pairs: renumber, keep a < b (flip the history with the roles), re-sort.
+  PairStore& q = s.pairs;
+  std::vector<std::size_t> perm(q.n);
+  for (std::size_t k = 0; k < q.n; ++k) {
+    std::int64_t a = new_index[q.a[k]], b = new_index[q.b[k]];
+    if (a > b) {
+      std::swap(a, b);
+      q.nx[k] = -q.nx[k]; q.ny[k] = -q.ny[k]; q.nz[k] = -q.nz[k];
+      q.fsx[k] = -q.fsx[k]; q.fsy[k] = -q.fsy[k]; q.fsz[k] = -q.fsz[k];
+    }
+    q.a[k] = a;
+    q.b[k] = b;
+  }
+  std::iota(perm.begin(), perm.end(), 0);
+  std::sort(perm.begin(), perm.end(), [&](std::size_t u, std::size_t v) {
+    return q.a[u] != q.a[v] ? q.a[u] < q.a[v] : q.b[u] < q.b[v];
+  });
+  PairStore sorted;
+  sorted.resize(q.n);
+  for (std::size_t k = 0; k < q.n; ++k) {
+    const std::size_t o = perm[k];
+    sorted.a[k] = q.a[o]; sorted.b[k] = q.b[o];
+    sorted.nx[k] = q.nx[o]; sorted.ny[k] = q.ny[o]; sorted.nz[k] = q.nz[o];
+    sorted.fsx[k] = q.fsx[o]; sorted.fsy[k] = q.fsy[o]; sorted.fsz[k] = q.fsz[o];
+    sorted.fn[k] = q.fn[o]; sorted.overlap[k] = q.overlap[o];
+  }
+  q = std::move(sorted);
+
+  // Wall contacts: renumber and re-sort by (particle, wall, facet).
+  WallContacts& w = s.walls.contacts;
+  for (std::size_t k = 0; k < w.n; ++k) w.particle[k] = std::int32_t(new_index[w.particle[k]]);
+  std::vector<std::size_t> wp(w.n);
+  std::iota(wp.begin(), wp.end(), 0);
+  std::sort(wp.begin(), wp.end(), [&](std::size_t u, std::size_t v) {
+    return std::tie(w.particle[u], w.wall[u], w.facet[u]) <
+           std::tie(w.particle[v], w.wall[v], w.facet[v]);
+  });
+  WallContacts ws;
+  ws.resize(w.n);
+  for (std::size_t k = 0; k < w.n; ++k) {
+    const std::size_t o = wp[k];
+    ws.particle[k] = w.particle[o]; ws.wall[k] = w.wall[o]; ws.facet[k] = w.facet[o];
+    ws.nx[k] = w.nx[o]; ws.ny[k] = w.ny[o]; ws.nz[k] = w.nz[o];
+    ws.fsx[k] = w.fsx[o]; ws.fsy[k] = w.fsy[o]; ws.fsz[k] = w.fsz[o];
+    ws.fn[k] = w.fn[o]; ws.overlap[k] = w.overlap[o];
+  }
+  w = std::move(ws);
+
+  for (auto& grp : s.groups) {
+    for (auto& m : grp.members) m = std::int32_t(new_index[m]);
+    std::sort(grp.members.begin(), grp.members.end());
+  }
+  ++s.reorders;
+}
+
+// The j > i within reach of particle i, ascending.
+template <class Out>
+void neighbours_of(const State& s, const CellGrid& g, std::size_t i, Out&& out) {
+  const ParticleStore& p = s.p;
+  int ci, cj, ck;
+  g.coords(p.x[i], p.y[i], p.z[i], ci, cj, ck);
+  const double reach = p.radius[i] + s.skin;
+  const std::int32_t gi = p.group[i];
+  for (int k = std::max(ck - 1, 0); k <= std::min(ck + 1, g.nz - 1); ++k)
+    for (int j = std::max(cj - 1, 0); j <= std::min(cj + 1, g.ny - 1); ++j)
+      for (int m = std::max(ci - 1, 0); m <= std::min(ci + 1, g.nx - 1); ++m) {
+        const std::size_t cell = (std::size_t(k) * g.ny + j) * g.nx + m;
+        for (std::int32_t t = g.start[cell]; t < g.start[cell + 1]; ++t) {
+          const std::int32_t o = g.members[t];
+          if (std::size_t(o) <= i) continue;
+          if (gi >= 0 && p.group[o] == gi) continue;
+          const double dx = p.x[o] - p.x[i], dy = p.y[o] - p.y[i], dz = p.z[o] - p.z[i];
+          const double cut = reach + p.radius[o];
+          if (dx * dx + dy * dy + dz * dz < cut * cut) out(o);
+        }
+      }
+}
+
+void build_pairs(State& s, const CellGrid& g) {
+  const std::size_t n = s.p.n;
+  std::vector<std::int64_t> count(n + 1, 0);
+#pragma omp parallel for schedule(dynamic, 256) num_threads(thread_count(s))
+  for (std::size_t i = 0; i < n; ++i) {
+    std::int64_t c = 0;
+    neighbours_of(s, g, i, [&](std::int32_t) { ++c; });
+    count[i + 1] = c;
+  }
+  std::partial_sum(count.begin(), count.end(), count.begin());
+  const std::size_t total = std::size_t(count[n]);
+
+  PairStore fresh;
+  fresh.resize(total);
+#pragma omp parallel for schedule(dynamic, 256) num_threads(thread_count(s))
+  for (std::size_t i = 0; i < n; ++i) {
+    std::size_t at = std::size_t(count[i]);
+    neighbours_of(s, g, i, [&](std::int32_t o) { fresh.b[at++] = o; });
+    std::sort(fresh.b.begin() + count[i], fresh.b.begin() + count[i + 1]);
+    for (std::int64_t k = count[i]; k < count[i + 1]; ++k) fresh.a[k] = std::int64_t(i);
+  }
+
+  // Carry history: both lists sorted by (a, b).
+  const PairStore& old = s.pairs;
+  std::size_t o = 0;
+  const ParticleStore& p = s.p;
+  for (std::size_t k = 0; k < total; ++k) {
+    const std::int64_t a = fresh.a[k], b = fresh.b[k];
+    while (o < old.n && (old.a[o] < a || (old.a[o] == a && old.b[o] < b))) ++o;
+    if (o < old.n && old.a[o] == a && old.b[o] == b) {
+      fresh.nx[k] = old.nx[o]; fresh.ny[k] = old.ny[o]; fresh.nz[k] = old.nz[o];
+      fresh.fsx[k] = old.fsx[o]; fresh.fsy[k] = old.fsy[o]; fresh.fsz[k] = old.fsz[o];
+      fresh.fn[k] = old.fn[o]; fresh.overlap[k] = old.overlap[o];
+    } else {
+      // New pair: no shear force; its "previous normal" is the current direction.
+      const double dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];
+      const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
+      fresh.nx[k] = d > 0 ? dx / d : 1.0;
+      fresh.ny[k] = d > 0 ? dy / d : 0.0;
+      fresh.nz[k] = d > 0 ? dz / d : 0.0;
+      fresh.fsx[k] = fresh.fsy[k] = fresh.fsz[k] = 0;
+      fresh.fn[k] = 0;
+      fresh.overlap[k] = p.radius[a] + p.radius[b] - d;
+    }
+  }
+  fresh.fill_padding(p.null_a(), p.null_b());
+  s.pairs = std::move(fresh);
+
+  // Incidence: for particle q, the pairs where it is b (all with a < q, so they come earlier in
+  // the list) and then those where it is a: ascending pair order.
+  Incidence& inc = s.incidence;
+  inc.start.assign(n + 1, 0);
+  for (std::size_t k = 0; k < total; ++k) {
+    ++inc.start[s.pairs.a[k] + 1];
+    ++inc.start[s.pairs.b[k] + 1];
+  }
+  std::partial_sum(inc.start.begin(), inc.start.end(), inc.start.begin());
+  inc.entry.resize(2 * total);
+  std::vector<std::int32_t> fill(inc.start.begin(), inc.start.end() - 1);
+  for (std::size_t k = 0; k < total; ++k) {
+    inc.entry[fill[s.pairs.b[k]]++] = std::int64_t(k) << 1 | 1;
+  }
+  for (std::size_t k = 0; k < total; ++k) inc.entry[fill[s.pairs.a[k]]++] = std::int64_t(k) << 1;
+  // Particles as b were filled first, then as a; each run is ascending and every b-pair of q
+  // precedes its a-pairs, so each particle's entries are in ascending pair order.
+}
+
+void build_wall_contacts(State& s) {
+  const ParticleStore& p = s.p;
+  const std::size_t n = p.n;
+  auto& walls = s.walls.walls;
+  std::vector<std::vector<std::array<std::int32_t, 2>>> cand(n);  // (wall, facet) per particle
+#pragma omp parallel num_threads(thread_count(s))
+  {
+    std::vector<std::int32_t> tris;
+#pragma omp for schedule(dynamic, 256)
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3 c{p.x[i], p.y[i], p.z[i]};
+      const double reach = p.radius[i] + s.skin;
+      for (std::size_t w = 0; w < walls.size(); ++w) {
+        const Wall& wall = walls[w];
+        if (wall.removed) continue;
+        if (wall.kind == Wall::Kind::plane) {
+          const double d = dot(c - (wall.point + wall.displacement), wall.normal);
+          if (d < reach) cand[i].push_back({std::int32_t(w), 0});
+        } else {
+          const Mesh& mesh = s.walls.meshes[wall.mesh];
+          const Vec3 q = c - wall.displacement;
+          query_mesh(mesh, q, reach, tris);
+          for (std::int32_t t : tris) {
+            const auto& tri = mesh.triangles[t];
+            int feature;
+            const Vec3 cp = closest_point_on_triangle(q, mesh.vertices[tri[0]],
+                                                      mesh.vertices[tri[1]],
+                                                      mesh.vertices[tri[2]], feature);
+            const Vec3 d = q - cp;
+            if (dot(d, d) < reach * reach) cand[i].push_back({std::int32_t(w), t});
+          }
+        }
+      }
+    }
+  }
+  WallContacts fresh;
+  std::size_t total = 0;
+  for (auto& c : cand) total += c.size();
+  fresh.resize(total);
+  fresh.start.assign(n + 1, 0);
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (auto& [w, f] : cand[i]) {
+      fresh.particle[k] = std::int32_t(i);
+      fresh.wall[k] = w;
+      fresh.facet[k] = f;
+      ++k;
+    }
+    fresh.start[i + 1] = std::int32_t(k);
+  }
+  // Carry history, both lists sorted by (particle, wall, facet).
+  const WallContacts& old = s.walls.contacts;
+  std::size_t o = 0;
+  for (k = 0; k < total; ++k) {
+    const auto key = std::tie(fresh.particle[k], fresh.wall[k], fresh.facet[k]);
+    while (o < old.n && std::tie(old.particle[o], old.wall[o], old.facet[o]) < key) ++o;
+    if (o < old.n && std::tie(old.particle[o], old.wall[o], old.facet[o]) == key) {
+      fresh.nx[k] = old.nx[o]; fresh.ny[k] = old.ny[o]; fresh.nz[k] = old.nz[o];
+      fresh.fsx[k] = old.fsx[o]; fresh.fsy[k] = old.fsy[o]; fresh.fsz[k] = old.fsz[o];
+      fresh.fn[k] = old.fn[o]; fresh.overlap[k] = old.overlap[o];
+    } else {
+      // No history yet: the wall kernel treats a zero normal as "take the current one".
+      fresh.nx[k] = fresh.ny[k] = fresh.nz[k] = 0;
+      fresh.fsx[k] = fresh.fsy[k] = fresh.fsz[k] = 0;
+      fresh.fn[k] = 0;
+      fresh.overlap[k] = -1;
+    }
+  }
+  s.walls.contacts = std::move(fresh);
+}
+
+}  // namespace
+
+void build_neighbors(State& s) {
+  ParticleStore& p = s.p;
+  if (s.skin <= 0) {
+    double mean = 0;
+    for (std::size_t i = 0; i < p.n; ++i) mean += p.radius[i];
+    s.skin = s.settings.skin > 0 ? s.settings.skin : 0.4 * (p.n ? mean / double(p.n) : 1e-3);
+  }
+  CellGrid grid = make_grid(p, s.skin);
+  const int every = s.settings.reorder_interval;
+  if (p.n > 0 && (s.force_reorder || (every > 0 && s.rebuilds_since_reorder >= std::uint64_t(every)))) {
+    reorder(s, grid);
+    grid = make_grid(p, s.skin);
+    s.rebuilds_since_reorder = 0;
+    s.force_reorder = false;
+  }
+  build_pairs(s, grid);
+  build_wall_contacts(s);
+  for (std::size_t i = 0; i < p.n; ++i) {
+    p.x0[i] = p.x[i];
+    p.y0[i] = p.y[i];
+    p.z0[i] = p.z[i];
+  }
+  for (auto& w : s.walls.walls) w.displacement_at_build = w.displacement;
+  ++s.rebuilds;
+  ++s.rebuilds_since_reorder;
+  s.need_rebuild = false;
+}
+
+}  // namespace asperity::detail

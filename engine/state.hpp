@@ -1,0 +1,99 @@
+// Everything a World holds, in one struct the stages share. See engine/step.cpp for the order in
+// which the stages read and write it.
+#pragma once
+#include <atomic>
+#include <cstdint>
+#include <vector>
+
+#include "asperity/world.hpp"
+#include "kernels/kernels.hpp"
+#include "store/pairs.hpp"
+#include "store/particles.hpp"
+#include "store/walls.hpp"
+
+namespace asperity::detail {
+
+struct Group {
+  std::vector<std::int32_t> members;  // current particle indices
+  GroupMotion motion;
+  double mass = 0;
+  Vec3 centre, velocity, angular_velocity;
+  Vec3 applied{0, 0, 0};
+  Vec3 force, torque;  // last step: contact + applied on members (torque about the centre)
+};
+
+// Cumulative ledgers of model.md 8 (kinetic and strain are computed on demand).
+struct Ledger {
+  double friction = 0, damping = 0, boundary = 0, gravity = 0;
+};
+
+// Work units: pairs and particles are processed in fixed blocks; per-block partial sums are
+// combined in block order, so sums do not depend on how blocks are spread over threads.
+inline constexpr std::size_t kPairBlock = 1024;      // multiple of kMaxLanes
+inline constexpr std::size_t kParticleBlock = 512;
+
+struct ParticleBlockResult {
+  double damping = 0, gravity = 0, applied = 0;
+  double kinetic = 0;        // at the step's time level: from the mean of old and new velocities
+  double max_disp2 = 0;      // squared displacement since the last build
+  double worst_step = 0;     // max of |v| dt / R and |w| dt / 0.1 rad (1 = health limit)
+  std::int32_t worst = -1;   // its particle index
+};
+
+struct State {
+  WorldSettings settings;
+  ParticleStore p;
+  PairStore pairs;
+  Incidence incidence;
+  WallStore walls;
+  std::vector<Group> groups;
+  const kernels::KernelSet* kernels = nullptr;
+
+  double dt = 0;             // in use
+  double dt_estimate = 0;    // last critical estimate (no safety factor)
+  bool dt_fixed = false;
+  std::uint64_t step = 0;
+  double time = 0;
+  std::uint64_t last_estimate_step = 0;
+
+  double skin = 0;
+  bool need_rebuild = true;
+  bool force_reorder = false;
+  std::uint64_t rebuilds = 0, reorders = 0, rebuilds_since_reorder = 0;
+
+  Ledger ledger;
+  // Kinetic energy at the time level of the last step's forces (mean of the half-step velocities
+  // around it), so that Ek and Es are measured at the same instant; invalid after the user
+  // changes velocities or positions, when it is computed from the stored velocities instead.
+  double kinetic_at_step = 0;
+  bool kinetic_valid = false;
+  double reference_energy = -1;  // Ek + Es when the run started (runaway check); <0: unset
+  double reference_input = 0;    // boundary + gravity work at that moment
+  std::atomic<bool> stop_requested{false};
+
+  std::vector<double> pair_block_slip;
+  std::vector<ParticleBlockResult> particle_blocks;
+};
+
+// Stages of one step (engine/step.cpp runs them in this order).
+void build_neighbors(State& s);         // neighbor/build.cpp
+void compute_pair_forces(State& s);     // kernels/pairs.cpp
+void compute_wall_forces(State& s);     // kernels/walls.cpp
+void gather_and_integrate(State& s);    // kernels/integrate.cpp
+void advance_groups(State& s);          // bodies/groups.cpp
+double estimate_critical_dt(const State& s);  // step.cpp
+Energies compute_energies(const State& s);    // step.cpp
+void step_once(State& s);               // step.cpp
+
+// Geometry helpers shared by the wall kernel and the neighbour search (kernels/walls.cpp).
+// Closest point on triangle (a, b, c) to p; `feature`: 0 face, 1..3 vertex a, b, c, 4..6 edge ab,
+// bc, ca.
+Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
+                               int& feature);
+void bin_mesh(Mesh& mesh);
+// Candidate triangles of `mesh` within `reach` of the point `q` (mesh coordinates), sorted.
+void query_mesh(const Mesh& mesh, const Vec3& q, double reach, std::vector<std::int32_t>& out);
+
+inline int thread_count(const State& s) { return s.settings.threads; }
+
+}  // namespace asperity::detail

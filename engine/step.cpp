@@ -1,0 +1,200 @@
+// One step, in named stages (design.md "One step"):
+//   1 neighbors   rebuild the pair list when something moved more than skin/2 (history carried)
+//   2 contacts    pair kernel -> per-pair normal, shear force, normal force, overlap
+//   3 walls       ball-wall kernel -> per-contact results, wall forces, wall work
+//   4+7 gather and integrate (fused) -> particle forces; free particles advanced
+//   6 groups      rigid groups advanced, members moved
+//   8 bookkeep    ledgers, health checks, rebuild criterion, time-step estimate
+// (Stage 5, bonds, arrives with the bonded-particle model.)
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "state.hpp"
+
+namespace asperity::detail {
+
+namespace {
+
+[[noreturn]] void health_error(const State& s, const std::string& what, std::int64_t index,
+                               const std::string& quantity, double value) {
+  const std::int64_t id = index >= 0 ? s.p.id[index] : -1;
+  std::ostringstream m;
+  m << "simulation unhealthy at step " << s.step << ": " << what;
+  if (id >= 0) m << " (particle " << id << ")";
+  m << "; " << quantity << " = " << value;
+  throw HealthError(m.str(), s.step, id, quantity, value);
+}
+
+void check_dt(State& s) {
+  s.dt_estimate = estimate_critical_dt(s);
+  s.last_estimate_step = s.step;
+  if (!s.dt_fixed) {
+    s.dt = s.settings.dt_safety * s.dt_estimate;
+  } else if (s.dt > s.dt_estimate && !s.settings.allow_dt_above_estimate) {
+    std::ostringstream m;
+    m << "time step " << s.dt << " s is above the critical estimate " << s.dt_estimate
+      << " s [3-30..3-32]; lower dt, set dt = 0 for automatic, or allow_dt_above_estimate";
+    health_error(s, m.str(), -1, "dt", s.dt);
+  }
+}
+
+void bookkeep(State& s) {
+  const ParticleStore& p = s.p;
+  double max_disp2 = 0, worst = 0;
+  std::int64_t worst_i = -1;
+  for (const auto& r : s.particle_blocks) {
+    s.kinetic_at_step += r.kinetic;
+    if (s.settings.track_energy) {
+      s.ledger.damping += r.damping;
+      s.ledger.gravity += r.gravity;
+      s.ledger.boundary += r.applied;
+    }
+    max_disp2 = std::max(max_disp2, r.max_disp2);
+    if (!(r.max_disp2 == r.max_disp2)) max_disp2 = r.max_disp2;  // NaN wins
+    if (r.worst >= 0 && !(r.worst_step <= worst)) {
+      worst = r.worst_step;
+      worst_i = r.worst;
+    }
+  }
+  // Group members were moved by advance_groups: their displacement counts for the skin too.
+  for (const Group& g : s.groups)
+    for (std::int32_t i : g.members) {
+      const double dx = p.x[i] - p.x0[i], dy = p.y[i] - p.y0[i], dz = p.z[i] - p.z0[i];
+      max_disp2 = std::max(max_disp2, dx * dx + dy * dy + dz * dz);
+      if (!std::isfinite(p.x[i] + p.y[i] + p.z[i])) health_error(s, "non-finite position", i, "x", p.x[i]);
+    }
+  if (worst_i >= 0 && !std::isfinite(worst))
+    health_error(s, "non-finite velocity or position", worst_i, "velocity", worst);
+  if (worst > 1.0)
+    health_error(s, "a particle moved more than its radius (or turned more than 0.1 rad) in one "
+                    "step: contacts are not resolved (time step too large, loading too fast, or "
+                    "a runaway)",
+                 worst_i, "step displacement / R", worst);
+
+  double wall_move = 0;
+  for (const auto& w : s.walls.walls) wall_move = std::max(wall_move, norm(w.displacement - w.displacement_at_build));
+  if (std::sqrt(max_disp2) + wall_move > 0.5 * s.skin) s.need_rebuild = true;
+}
+
+// Runaway energy: with every dissipation term non-negative, Ek + Es can never exceed what it was
+// when the run started plus the work put in since. Far beyond that, the integration is creating
+// energy. Checked every dt_interval steps (it costs a pass over particles and pairs).
+void check_energy(State& s) {
+  if (!s.settings.track_energy) return;
+  const Energies e = compute_energies(s);
+  const double now = e.kinetic + e.strain;
+  const double input = s.ledger.boundary + s.ledger.gravity;
+  if (s.reference_energy < 0) {
+    s.reference_energy = now;
+    s.reference_input = input;
+    return;
+  }
+  const double allowed = s.reference_energy + std::max(0.0, input - s.reference_input);
+  if (now > 2.0 * allowed && now > 1e-300) {
+    std::ostringstream m;
+    m << "kinetic + strain energy " << now << " J exceeds twice the initial energy plus the work "
+         "put in (" << allowed << " J): energy is being created, the integration is unstable";
+    health_error(s, m.str(), -1, "kinetic + strain energy", now);
+  }
+}
+
+}  // namespace
+
+double estimate_critical_dt(const State& s) {
+  // [3-30..3-32]: per body and degree of freedom sqrt(m / k_tran), sqrt(I / k_rot), with the
+  // stiffness summed over the body's touching contacts. A body without contacts counts as having
+  // one, so the estimate stays finite (and sane) before the first contact forms.
+  const ParticleStore& p = s.p;
+  const std::size_t n = p.n;
+  const ContactMaterial& m = s.settings.contact;
+  const double kc = std::max(m.kn, m.ks);
+  std::vector<double> ktran(n, 0.0), krot(n, 0.0);
+  for (std::size_t k = 0; k < s.pairs.n; ++k) {
+    const double U = s.pairs.overlap[k];
+    if (!(U > 0)) continue;
+    const auto a = s.pairs.a[k], b = s.pairs.b[k];
+    ktran[a] += kc;
+    ktran[b] += kc;
+    const double la = p.radius[a] - 0.5 * U, lb = p.radius[b] - 0.5 * U;
+    krot[a] += m.ks * la * la;
+    krot[b] += m.ks * lb * lb;
+  }
+  const WallContacts& wc = s.walls.contacts;
+  for (std::size_t k = 0; k < wc.n; ++k) {
+    const double U = wc.overlap[k];
+    if (!(U > 0)) continue;
+    const ContactMaterial& wm = s.walls.walls[wc.wall[k]].material;
+    const auto i = wc.particle[k];
+    ktran[i] += std::max(wm.kn, wm.ks);
+    const double l = p.radius[i] - 0.5 * U;
+    krot[i] += wm.ks * l * l;
+  }
+  double best = std::numeric_limits<double>::infinity();
+  for (const Group& g : s.groups) {  // a group is one body
+    double k = 0;
+    for (std::int32_t i : g.members) k += ktran[i];
+    if (k > 0) best = std::min(best, std::sqrt(g.mass / k));
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (p.group[i] >= 0) continue;
+    const double kt = ktran[i] > 0 ? ktran[i] : kc;
+    best = std::min(best, std::sqrt(p.mass[i] / kt));
+    if (s.settings.rotation && !p.rotation_locked[i]) {
+      const double kr = krot[i] > 0 ? krot[i] : m.ks * p.radius[i] * p.radius[i];
+      best = std::min(best, std::sqrt(p.inertia[i] / kr));
+    }
+  }
+  return best;
+}
+
+Energies compute_energies(const State& s) {
+  Energies e;
+  const ParticleStore& p = s.p;
+  if (s.kinetic_valid) {
+    e.kinetic = s.kinetic_at_step;
+  } else {
+    for (std::size_t i = 0; i < p.n; ++i)
+      e.kinetic += 0.5 * p.mass[i] * (p.vx[i] * p.vx[i] + p.vy[i] * p.vy[i] + p.vz[i] * p.vz[i]) +
+                   0.5 * p.inertia[i] * (p.wx[i] * p.wx[i] + p.wy[i] * p.wy[i] + p.wz[i] * p.wz[i]);
+  }
+  const ContactMaterial& m = s.settings.contact;
+  const PairStore& q = s.pairs;
+  for (std::size_t k = 0; k < q.n; ++k) {
+    if (!(q.overlap[k] > 0)) continue;
+    e.strain += q.fn[k] * q.fn[k] / (2 * m.kn) +
+                (q.fsx[k] * q.fsx[k] + q.fsy[k] * q.fsy[k] + q.fsz[k] * q.fsz[k]) / (2 * m.ks);
+  }
+  const WallContacts& wc = s.walls.contacts;
+  for (std::size_t k = 0; k < wc.n; ++k) {
+    if (!(wc.overlap[k] > 0)) continue;
+    const ContactMaterial& wm = s.walls.walls[wc.wall[k]].material;
+    e.strain += wc.fn[k] * wc.fn[k] / (2 * wm.kn) +
+                (wc.fsx[k] * wc.fsx[k] + wc.fsy[k] * wc.fsy[k] + wc.fsz[k] * wc.fsz[k]) / (2 * wm.ks);
+  }
+  e.friction = s.ledger.friction;
+  e.damping = s.ledger.damping;
+  e.boundary_work = s.ledger.boundary;
+  e.gravity_work = s.ledger.gravity;
+  return e;
+}
+
+void step_once(State& s) {
+  const bool rebuilt = s.need_rebuild;
+  if (rebuilt) build_neighbors(s);
+  const bool estimate_due = s.step >= s.last_estimate_step + std::uint64_t(s.settings.dt_interval);
+  if (rebuilt || estimate_due || s.dt <= 0) check_dt(s);
+  compute_pair_forces(s);
+  compute_wall_forces(s);
+  gather_and_integrate(s);
+  advance_groups(s);
+  for (auto& w : s.walls.walls) w.displacement += w.velocity * s.dt;
+  ++s.step;
+  s.time += s.dt;
+  bookkeep(s);
+  s.kinetic_valid = true;
+  if (estimate_due) check_energy(s);
+}
+
+}  // namespace asperity::detail

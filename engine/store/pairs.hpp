@@ -1,0 +1,49 @@
+// Pair store: the Verlet list of ball-ball pairs within the skin, touching or not, sorted by
+// (a, b) current indices with a < b. Per pair it keeps only what the gather cannot derive: the
+// contact normal and the shear force (both are also the history for the next step), the normal
+// force and the overlap. The gather builds force and torques from these eight numbers.
+//
+// Sign convention (model.md 4): n points from a to b; fn, fs act on b; -(fn n + fs) acts on a.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "core/aligned.hpp"
+
+namespace asperity::detail {
+
+struct PairStore {
+  std::size_t n = 0;       // real pairs
+  std::size_t padded = 0;  // n rounded up to kMaxLanes; the tail points at null particles
+  AVec<std::int64_t> a, b;
+  AVec<double> nx, ny, nz;     // unit normal a -> b (history: normal of the last step)
+  AVec<double> fsx, fsy, fsz;  // shear force on b (history)
+  AVec<double> fn;             // normal force on b along n (>= 0)
+  AVec<double> overlap;        // U = Ra + Rb - d (negative: not touching)
+
+  void resize(std::size_t count) {
+    n = count;
+    padded = round_up(count, kMaxLanes);
+    for (auto* c : {&a, &b}) c->resize(padded);
+    for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &overlap}) c->resize(padded);
+  }
+  // Padding entries: pair of two null particles, unit normal along x, no force.
+  void fill_padding(std::int64_t null_a, std::int64_t null_b) {
+    for (std::size_t i = n; i < padded; ++i) {
+      a[i] = null_a;
+      b[i] = null_b;
+      nx[i] = 1;
+      ny[i] = nz[i] = fsx[i] = fsy[i] = fsz[i] = fn[i] = 0;
+      overlap[i] = -1;
+    }
+  }
+};
+
+// Per-particle incidence (CSR) into the pair list: entries (pair << 1) | (particle is b), in
+// increasing pair order. The gather walks it, so its sums have a fixed order for any thread count.
+struct Incidence {
+  std::vector<std::int32_t> start;  // n + 1 offsets
+  std::vector<std::int64_t> entry;
+};
+
+}  // namespace asperity::detail

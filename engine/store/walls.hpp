@@ -1,0 +1,67 @@
+// Walls (model.md 1): infinite planes and triangle meshes, moved only by prescription, and the
+// list of ball-wall contacts with their shear history.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "asperity/world.hpp"
+#include "core/aligned.hpp"
+
+namespace asperity::detail {
+
+// Uniform grid over a mesh's bounding box; each triangle is listed in every cell its bounding box
+// overlaps. A query touches only the cells around one particle, so the cost of finding a
+// particle's candidate triangles does not grow with the size of the mesh.
+struct TriangleBins {
+  Vec3 origin;
+  double cell = 1;
+  std::array<int, 3> dims{1, 1, 1};
+  std::vector<std::int32_t> start;  // cells + 1
+  std::vector<std::int32_t> triangles;
+};
+
+struct Mesh {
+  std::vector<Vec3> vertices;  // at creation; the wall's displacement is added
+  std::vector<std::array<int, 3>> triangles;
+  // Bits 0-2: this triangle owns its edge AB, BC, CA; bits 3-5: its vertex A, B, C. A contact whose
+  // closest point lies on an edge or vertex shared by several triangles counts only for the owner
+  // (the lowest-numbered triangle sharing it), so a sphere on a fold is pushed once, not twice.
+  std::vector<std::uint8_t> owns;
+  TriangleBins bins;
+};
+
+struct Wall {
+  enum class Kind : std::uint8_t { plane, mesh } kind = Kind::plane;
+  ContactMaterial material;
+  Vec3 point, normal;      // plane: through point (at creation), unit normal towards particles
+  int mesh = -1;           // index into WallStore::meshes
+  Vec3 velocity{0, 0, 0};
+  Vec3 displacement{0, 0, 0};          // since creation
+  Vec3 displacement_at_build{0, 0, 0};
+  Vec3 force{0, 0, 0};                 // of the particles on the wall, last step
+  bool removed = false;
+};
+
+// Ball-wall contacts within the skin, sorted by (particle, wall, facet). The particle plays the
+// role of b in the contact law: the normal points from the wall to the centre.
+struct WallContacts {
+  std::size_t n = 0;
+  std::vector<std::int32_t> particle, wall, facet;
+  std::vector<double> nx, ny, nz, fsx, fsy, fsz, fn, overlap;
+  std::vector<std::int32_t> start;  // per particle offsets (CSR), particles + 1
+
+  void resize(std::size_t count) {
+    n = count;
+    for (auto* c : {&particle, &wall, &facet}) c->resize(count);
+    for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &overlap}) c->resize(count);
+  }
+};
+
+struct WallStore {
+  std::vector<Wall> walls;
+  std::vector<Mesh> meshes;
+  WallContacts contacts;
+};
+
+}  // namespace asperity::detail

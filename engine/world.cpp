@@ -1,0 +1,545 @@
+// World: the public API over the stores and the step driver. Every function checks its input
+// and says what was wrong; ids are stable, indices are internal.
+#include "asperity/world.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <sstream>
+
+#include "state.hpp"
+
+namespace asperity {
+
+using detail::State;
+
+namespace {
+
+void require(bool ok, const std::string& message) {
+  if (!ok) throw Error(message);
+}
+
+std::string num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+void require_finite(const Vec3& v, const char* what) {
+  require(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z),
+          std::string(what) + " must be finite, got (" + num(v.x) + ", " + num(v.y) + ", " +
+              num(v.z) + ")");
+}
+
+void check_material(const ContactMaterial& m, const char* where) {
+  require(m.kn > 0 && std::isfinite(m.kn), std::string(where) + ": kn must be > 0, got " + num(m.kn));
+  require(m.ks >= 0 && std::isfinite(m.ks), std::string(where) + ": ks must be >= 0, got " + num(m.ks));
+  require(m.friction >= 0 && std::isfinite(m.friction),
+          std::string(where) + ": friction must be >= 0, got " + num(m.friction));
+}
+
+void set_mass(detail::ParticleStore& p, std::size_t i) {
+  const double r = p.radius[i];
+  p.mass[i] = p.density[i] * 4.0 / 3.0 * std::numbers::pi * r * r * r;  // [3-4]
+  p.inertia[i] = 0.4 * p.mass[i] * r * r;
+  p.inv_mass[i] = 1.0 / p.mass[i];
+  p.inv_inertia[i] = 1.0 / p.inertia[i];
+}
+
+void touch(State& s) {  // the user changed the state: rebuild, re-estimate, re-reference energy
+  s.need_rebuild = true;
+  s.reference_energy = -1;
+  s.kinetic_valid = false;
+}
+
+void recompute_group(State& s, detail::Group& g) {
+  const auto& p = s.p;
+  g.mass = 0;
+  Vec3 c{0, 0, 0};
+  for (auto i : g.members) {
+    g.mass += p.mass[i];
+    c += Vec3{p.x[i], p.y[i], p.z[i]} * p.mass[i];
+  }
+  g.centre = g.mass > 0 ? c / g.mass : Vec3{};
+}
+
+}  // namespace
+
+double Energies::balance_error(const Energies& initial) const {
+  const double input = (boundary_work - initial.boundary_work) + (gravity_work - initial.gravity_work);
+  const double out = (kinetic - initial.kinetic) + (strain - initial.strain) +
+                     (friction - initial.friction) + (damping - initial.damping);
+  return input - out;
+}
+
+World::World(WorldSettings settings) : state_(std::make_unique<State>()) {
+  State& s = *state_;
+  check_material(settings.contact, "contact material");
+  require(settings.density > 0, "density must be > 0, got " + num(settings.density));
+  require(settings.local_damping >= 0 && settings.local_damping < 1,
+          "local_damping must be in [0, 1), got " + num(settings.local_damping));
+  require(settings.skin >= 0, "skin must be >= 0 (0: automatic), got " + num(settings.skin));
+  require(settings.dt >= 0, "dt must be >= 0 (0: automatic), got " + num(settings.dt));
+  require(settings.dt_safety > 0 && settings.dt_safety <= 1,
+          "dt_safety must be in (0, 1], got " + num(settings.dt_safety));
+  require(settings.dt_interval >= 1, "dt_interval must be >= 1");
+  require(settings.threads >= 0, "threads must be >= 0 (0: all cores)");
+  require(settings.reorder_interval >= 0, "reorder_interval must be >= 0");
+  require_finite(settings.gravity, "gravity");
+  s.kernels = &kernels::select_kernels(settings.simd);
+  if (settings.threads == 0) settings.threads = omp_get_max_threads();
+  s.settings = settings;
+  s.dt_fixed = settings.dt > 0;
+  s.dt = settings.dt;
+  s.p.resize(0);
+  s.pairs.resize(0);
+  s.pairs.fill_padding(s.p.null_a(), s.p.null_b());
+}
+
+World::~World() = default;
+World::World(World&&) noexcept = default;
+World& World::operator=(World&&) noexcept = default;
+
+const WorldSettings& World::settings() const { return state_->settings; }
+
+namespace {
+std::size_t index_of(const State& s, std::int64_t id) {
+  if (id < 0 || id >= static_cast<std::int64_t>(s.p.index_of_id.size()))
+    throw Error("no particle with id " + std::to_string(id) + " (valid ids: 0.." +
+                std::to_string(static_cast<std::int64_t>(s.p.index_of_id.size()) - 1) + ")");
+  return static_cast<std::size_t>(s.p.index_of_id[id]);
+}
+int check_wall(const State& s, int wall) {
+  if (wall < 0 || wall >= int(s.walls.walls.size()))
+    throw Error("no wall " + std::to_string(wall) + " (walls: 0.." +
+                std::to_string(int(s.walls.walls.size()) - 1) + ")");
+  return wall;
+}
+int check_group(const State& s, int group) {
+  if (group < 0 || group >= int(s.groups.size()))
+    throw Error("no group " + std::to_string(group) + " (groups: 0.." +
+                std::to_string(int(s.groups.size()) - 1) + ")");
+  return group;
+}
+}  // namespace
+
+std::int64_t World::add_particle(Vec3 position, double radius, double density) {
+  const double xyz[3] = {position.x, position.y, position.z};
+  return add_particles(std::span<const double>(xyz, 3), std::span<const double>(&radius, 1), density);
+}
+
+std::int64_t World::add_particles(std::span<const double> xyz, std::span<const double> radii,
+                                  double density) {
+  State& s = *state_;
+  require(xyz.size() == 3 * radii.size(), "add_particles: " + std::to_string(xyz.size()) +
+                                              " coordinates for " + std::to_string(radii.size()) +
+                                              " radii (expected 3 per particle)");
+  const double rho = density > 0 ? density : s.settings.density;
+  require(std::isfinite(rho), "density must be finite");
+  for (std::size_t k = 0; k < radii.size(); ++k) {
+    require(radii[k] > 0 && std::isfinite(radii[k]),
+            "radius of particle " + std::to_string(k) + " must be > 0, got " + num(radii[k]));
+    require_finite({xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]}, "particle position");
+  }
+  auto& p = s.p;
+  const std::size_t first = p.n;
+  const std::int64_t first_id = static_cast<std::int64_t>(p.index_of_id.size());
+  p.resize(p.n + radii.size());
+  for (std::size_t k = 0; k < radii.size(); ++k) {
+    const std::size_t i = first + k;
+    p.x[i] = xyz[3 * k];
+    p.y[i] = xyz[3 * k + 1];
+    p.z[i] = xyz[3 * k + 2];
+    p.vx[i] = p.vy[i] = p.vz[i] = p.wx[i] = p.wy[i] = p.wz[i] = 0;
+    p.fx[i] = p.fy[i] = p.fz[i] = p.tx[i] = p.ty[i] = p.tz[i] = 0;
+    p.radius[i] = radii[k];
+    p.density[i] = rho;
+    set_mass(p, i);
+    p.rotation_locked[i] = s.settings.rotation ? 0 : 1;
+    p.group[i] = -1;
+    p.id[i] = first_id + std::int64_t(k);
+    p.index_of_id.push_back(std::int64_t(i));
+  }
+  s.force_reorder = true;
+  touch(s);
+  return first_id;
+}
+
+std::size_t World::particle_count() const { return state_->p.n; }
+
+#define ASPERITY_VEC(col) \
+  Vec3 { p.col##x[i], p.col##y[i], p.col##z[i] }
+
+Vec3 World::position(std::int64_t id) const {
+  const auto& p = state_->p;
+  const auto i = index_of(*state_, id);
+  return {p.x[i], p.y[i], p.z[i]};
+}
+Vec3 World::velocity(std::int64_t id) const {
+  const auto& p = state_->p;
+  const auto i = index_of(*state_, id);
+  return ASPERITY_VEC(v);
+}
+Vec3 World::angular_velocity(std::int64_t id) const {
+  const auto& p = state_->p;
+  const auto i = index_of(*state_, id);
+  return ASPERITY_VEC(w);
+}
+Vec3 World::force(std::int64_t id) const {
+  const auto& p = state_->p;
+  const auto i = index_of(*state_, id);
+  return ASPERITY_VEC(f);
+}
+Vec3 World::torque(std::int64_t id) const {
+  const auto& p = state_->p;
+  const auto i = index_of(*state_, id);
+  return ASPERITY_VEC(t);
+}
+#undef ASPERITY_VEC
+double World::radius(std::int64_t id) const { return state_->p.radius[index_of(*state_, id)]; }
+double World::mass(std::int64_t id) const { return state_->p.mass[index_of(*state_, id)]; }
+int World::group_of(std::int64_t id) const { return state_->p.group[index_of(*state_, id)]; }
+
+void World::set_position(std::int64_t id, Vec3 x) {
+  require_finite(x, "position");
+  auto& p = state_->p;
+  const auto i = index_of(*state_, id);
+  require(p.group[i] < 0, "particle " + std::to_string(id) + " belongs to group " +
+                              std::to_string(p.group[i]) + ": move the group, not the member");
+  p.x[i] = x.x;
+  p.y[i] = x.y;
+  p.z[i] = x.z;
+  touch(*state_);
+}
+void World::set_velocity(std::int64_t id, Vec3 v) {
+  require_finite(v, "velocity");
+  auto& p = state_->p;
+  const auto i = index_of(*state_, id);
+  require(p.group[i] < 0, "particle " + std::to_string(id) + " belongs to group " +
+                              std::to_string(p.group[i]) + ": set the group's motion instead");
+  p.vx[i] = v.x;
+  p.vy[i] = v.y;
+  p.vz[i] = v.z;
+  state_->reference_energy = -1;
+  state_->kinetic_valid = false;
+}
+void World::set_angular_velocity(std::int64_t id, Vec3 w) {
+  require_finite(w, "angular velocity");
+  auto& p = state_->p;
+  const auto i = index_of(*state_, id);
+  require(!p.rotation_locked[i], "particle " + std::to_string(id) +
+                                     " cannot rotate (rotation locked or disabled in the world)");
+  p.wx[i] = w.x;
+  p.wy[i] = w.y;
+  p.wz[i] = w.z;
+  state_->reference_energy = -1;
+  state_->kinetic_valid = false;
+}
+void World::set_radius(std::int64_t id, double r) {
+  require(r > 0 && std::isfinite(r), "radius must be > 0, got " + num(r));
+  auto& p = state_->p;
+  const auto i = index_of(*state_, id);
+  p.radius[i] = r;
+  set_mass(p, i);
+  for (auto& g : state_->groups) recompute_group(*state_, g);
+  touch(*state_);
+}
+void World::scale_radii(double factor) {
+  require(factor > 0 && std::isfinite(factor), "scale_radii: factor must be > 0, got " + num(factor));
+  auto& p = state_->p;
+  for (std::size_t i = 0; i < p.n; ++i) {
+    p.radius[i] *= factor;
+    set_mass(p, i);
+  }
+  for (auto& g : state_->groups) recompute_group(*state_, g);
+  state_->skin = 0;  // re-derive an automatic skin from the new radii
+  touch(*state_);
+}
+void World::set_applied_force(std::int64_t id, Vec3 f) {
+  require_finite(f, "applied force");
+  auto& p = state_->p;
+  const auto i = index_of(*state_, id);
+  if (!p.has_applied) {
+    p.has_applied = true;
+    for (auto* c : {&p.ax, &p.ay, &p.az}) c->assign(p.capacity, 0.0);
+  }
+  p.ax[i] = f.x;
+  p.ay[i] = f.y;
+  p.az[i] = f.z;
+}
+void World::set_rotation_locked(std::int64_t id, bool locked) {
+  auto& p = state_->p;
+  const auto i = index_of(*state_, id);
+  require(state_->settings.rotation || locked,
+          "rotation is disabled in this world (settings.rotation = false)");
+  p.rotation_locked[i] = locked ? 1 : 0;
+  if (locked) p.wx[i] = p.wy[i] = p.wz[i] = 0;
+}
+
+namespace {
+std::vector<double> by_id(const State& s, const AVec<double>& a,
+                          const AVec<double>* b = nullptr,
+                          const AVec<double>* c = nullptr) {
+  const auto& p = s.p;
+  const std::size_t per = b ? 3 : 1;
+  std::vector<double> out(p.n * per);
+  for (std::size_t id = 0; id < p.n; ++id) {
+    const auto i = p.index_of_id[id];
+    out[per * id] = a[i];
+    if (b) {
+      out[per * id + 1] = (*b)[i];
+      out[per * id + 2] = (*c)[i];
+    }
+  }
+  return out;
+}
+}  // namespace
+
+std::vector<double> World::positions() const { const auto& p = state_->p; return by_id(*state_, p.x, &p.y, &p.z); }
+std::vector<double> World::velocities() const { const auto& p = state_->p; return by_id(*state_, p.vx, &p.vy, &p.vz); }
+std::vector<double> World::forces() const { const auto& p = state_->p; return by_id(*state_, p.fx, &p.fy, &p.fz); }
+std::vector<double> World::radii() const { return by_id(*state_, state_->p.radius); }
+
+// --- walls ---------------------------------------------------------------------------------
+
+int World::add_plane(Vec3 point, Vec3 normal, ContactMaterial material) {
+  require_finite(point, "plane point");
+  require_finite(normal, "plane normal");
+  const double len = norm(normal);
+  require(len > 0, "plane normal must be non-zero");
+  check_material(material, "plane material");
+  detail::Wall w;
+  w.kind = detail::Wall::Kind::plane;
+  w.point = point;
+  w.normal = normal / len;
+  w.material = material;
+  state_->walls.walls.push_back(w);
+  touch(*state_);
+  return int(state_->walls.walls.size()) - 1;
+}
+
+int World::add_mesh(std::span<const Vec3> vertices, std::span<const std::array<int, 3>> triangles,
+                    ContactMaterial material) {
+  check_material(material, "mesh material");
+  require(!triangles.empty(), "add_mesh: no triangles");
+  for (const auto& v : vertices) require_finite(v, "mesh vertex");
+  detail::Mesh mesh;
+  mesh.vertices.assign(vertices.begin(), vertices.end());
+  mesh.triangles.assign(triangles.begin(), triangles.end());
+  const int nv = int(vertices.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k)
+      require(triangles[t][k] >= 0 && triangles[t][k] < nv,
+              "add_mesh: triangle " + std::to_string(t) + " refers to vertex " +
+                  std::to_string(triangles[t][k]) + " (vertices: 0.." + std::to_string(nv - 1) + ")");
+  // Ownership of shared edges and vertices: the lowest-numbered triangle owns them.
+  std::map<std::pair<int, int>, int> edge_owner;
+  std::vector<int> vertex_owner(vertices.size(), -1);
+  for (int t = 0; t < int(triangles.size()); ++t) {
+    const auto& tri = triangles[t];
+    for (int k = 0; k < 3; ++k) {
+      const int a = tri[k], b = tri[(k + 1) % 3];
+      edge_owner.try_emplace({std::min(a, b), std::max(a, b)}, t);
+      if (vertex_owner[a] < 0) vertex_owner[a] = t;
+    }
+  }
+  mesh.owns.assign(triangles.size(), 0);
+  for (int t = 0; t < int(triangles.size()); ++t) {
+    const auto& tri = triangles[t];
+    for (int k = 0; k < 3; ++k) {
+      const int a = tri[k], b = tri[(k + 1) % 3];
+      if (edge_owner[{std::min(a, b), std::max(a, b)}] == t) mesh.owns[t] |= std::uint8_t(1 << k);
+      if (vertex_owner[a] == t) mesh.owns[t] |= std::uint8_t(1 << (3 + k));
+    }
+  }
+  detail::bin_mesh(mesh);
+  state_->walls.meshes.push_back(std::move(mesh));
+  detail::Wall w;
+  w.kind = detail::Wall::Kind::mesh;
+  w.mesh = int(state_->walls.meshes.size()) - 1;
+  w.material = material;
+  state_->walls.walls.push_back(w);
+  touch(*state_);
+  return int(state_->walls.walls.size()) - 1;
+}
+
+void World::set_wall_velocity(int wall, Vec3 v) {
+  require_finite(v, "wall velocity");
+  state_->walls.walls[check_wall(*state_, wall)].velocity = v;
+}
+Vec3 World::wall_velocity(int wall) const { return state_->walls.walls[check_wall(*state_, wall)].velocity; }
+Vec3 World::wall_displacement(int wall) const { return state_->walls.walls[check_wall(*state_, wall)].displacement; }
+Vec3 World::wall_force(int wall) const { return state_->walls.walls[check_wall(*state_, wall)].force; }
+void World::remove_wall(int wall) {
+  auto& w = state_->walls.walls[check_wall(*state_, wall)];
+  w.removed = true;
+  w.velocity = {0, 0, 0};
+  w.force = {0, 0, 0};
+  touch(*state_);
+}
+std::size_t World::wall_count() const { return state_->walls.walls.size(); }
+
+// --- groups --------------------------------------------------------------------------------
+
+int World::add_group(std::span<const std::int64_t> ids, GroupMotion motion) {
+  State& s = *state_;
+  require(!ids.empty(), "add_group: no particles given");
+  const int g = int(s.groups.size());
+  detail::Group grp;
+  for (auto id : ids) {
+    const auto i = index_of(s, id);
+    require(s.p.group[i] < 0, "add_group: particle " + std::to_string(id) +
+                                  " already belongs to group " + std::to_string(s.p.group[i]));
+    grp.members.push_back(std::int32_t(i));
+  }
+  std::sort(grp.members.begin(), grp.members.end());
+  require(std::adjacent_find(grp.members.begin(), grp.members.end()) == grp.members.end(),
+          "add_group: a particle id is listed twice");
+  for (auto i : grp.members) s.p.group[i] = g;
+  recompute_group(s, grp);
+  grp.velocity = {0, 0, 0};
+  s.groups.push_back(std::move(grp));
+  set_group_motion(g, motion);
+  touch(s);
+  return g;
+}
+
+void World::set_group_motion(int group, const GroupMotion& motion) {
+  require_finite(motion.velocity, "group velocity");
+  require_finite(motion.angular_velocity, "group angular velocity");
+  require(state_->settings.rotation || motion.rotation == Dof::fixed,
+          "group rotation needs a world with rotation enabled");
+  state_->groups[check_group(*state_, group)].motion = motion;
+}
+const GroupMotion& World::group_motion(int group) const { return state_->groups[check_group(*state_, group)].motion; }
+void World::set_group_applied_force(int group, Vec3 f) {
+  require_finite(f, "group applied force");
+  state_->groups[check_group(*state_, group)].applied = f;
+}
+Vec3 World::group_force(int group) const { return state_->groups[check_group(*state_, group)].force; }
+Vec3 World::group_torque(int group) const { return state_->groups[check_group(*state_, group)].torque; }
+Vec3 World::group_position(int group) const { return state_->groups[check_group(*state_, group)].centre; }
+Vec3 World::group_velocity(int group) const { return state_->groups[check_group(*state_, group)].velocity; }
+double World::group_mass(int group) const { return state_->groups[check_group(*state_, group)].mass; }
+std::vector<std::int64_t> World::group_members(int group) const {
+  std::vector<std::int64_t> out;
+  for (auto i : state_->groups[check_group(*state_, group)].members) out.push_back(state_->p.id[i]);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+std::size_t World::group_count() const { return state_->groups.size(); }
+
+// --- running -------------------------------------------------------------------------------
+
+std::uint64_t World::cycle(std::uint64_t n) {
+  State& s = *state_;
+  require(s.p.n > 0, "cycle: the world has no particles");
+  for (std::uint64_t k = 0; k < n; ++k) {
+    if (s.stop_requested.exchange(false)) return k;
+    detail::step_once(s);
+  }
+  return n;
+}
+void World::request_stop() { state_->stop_requested.store(true); }
+double World::dt() const { return state_->dt; }
+void World::set_dt(double dt) {
+  require(dt >= 0 && std::isfinite(dt), "dt must be >= 0 (0: automatic), got " + num(dt));
+  state_->dt_fixed = dt > 0;
+  state_->dt = dt;
+  state_->last_estimate_step = 0;
+  state_->need_rebuild = true;  // forces a fresh estimate (and its check) before the next step
+}
+double World::critical_dt() {
+  State& s = *state_;
+  if (s.need_rebuild && s.p.n > 0) detail::build_neighbors(s);
+  return detail::estimate_critical_dt(s);
+}
+std::uint64_t World::step_count() const { return state_->step; }
+double World::time() const { return state_->time; }
+void World::set_threads(int threads) {
+  require(threads >= 0, "threads must be >= 0 (0: all cores)");
+  state_->settings.threads = threads == 0 ? omp_get_max_threads() : threads;
+}
+std::string World::simd_architecture() const { return state_->kernels->name; }
+StepStats World::stats() const {
+  const State& s = *state_;
+  StepStats st;
+  st.rebuilds = s.rebuilds;
+  st.reorders = s.reorders;
+  st.pairs = s.pairs.n;
+  st.contacts = contact_count();
+  for (std::size_t k = 0; k < s.walls.contacts.n; ++k) st.wall_contacts += s.walls.contacts.overlap[k] > 0;
+  return st;
+}
+void World::rebuild_neighbors() {
+  if (state_->p.n > 0) detail::build_neighbors(*state_);
+}
+
+// --- measurements --------------------------------------------------------------------------
+
+Energies World::energies() const { return detail::compute_energies(*state_); }
+
+double World::unbalanced_force_ratio() const {
+  const State& s = *state_;
+  const auto& p = s.p;
+  const Vec3 g = s.settings.gravity;
+  double unbalanced = 0;
+  std::size_t bodies = 0;
+  for (std::size_t i = 0; i < p.n; ++i) {
+    if (p.group[i] >= 0) continue;
+    const double fx = p.fx[i] + p.mass[i] * g.x, fy = p.fy[i] + p.mass[i] * g.y,
+                 fz = p.fz[i] + p.mass[i] * g.z;
+    unbalanced += std::sqrt(fx * fx + fy * fy + fz * fz);
+    ++bodies;
+  }
+  double contact = 0;
+  std::size_t contacts = 0;
+  for (std::size_t k = 0; k < s.pairs.n; ++k)
+    if (s.pairs.overlap[k] > 0) { contact += s.pairs.fn[k]; ++contacts; }
+  for (std::size_t k = 0; k < s.walls.contacts.n; ++k)
+    if (s.walls.contacts.overlap[k] > 0) { contact += s.walls.contacts.fn[k]; ++contacts; }
+  if (bodies == 0) return 0;
+  if (contacts == 0 || contact == 0) return std::numeric_limits<double>::infinity();
+  return (unbalanced / double(bodies)) / (contact / double(contacts));
+}
+
+std::vector<ContactInfo> World::contacts() const {
+  const State& s = *state_;
+  const auto& p = s.p;
+  const auto& q = s.pairs;
+  std::vector<ContactInfo> out;
+  for (std::size_t k = 0; k < q.n; ++k) {
+    if (!(q.overlap[k] > 0)) continue;
+    const auto a = q.a[k], b = q.b[k];
+    ContactInfo c;
+    c.id_a = p.id[a];
+    c.id_b = p.id[b];
+    c.normal = {q.nx[k], q.ny[k], q.nz[k]};
+    c.overlap = q.overlap[k];
+    c.point = Vec3{p.x[a], p.y[a], p.z[a]} + c.normal * (p.radius[a] - 0.5 * c.overlap);  // [3-11]
+    c.normal_force = q.fn[k];
+    c.shear_force = {q.fsx[k], q.fsy[k], q.fsz[k]};
+    if (c.id_a > c.id_b) {  // report with id_a < id_b: flip the roles
+      std::swap(c.id_a, c.id_b);
+      c.normal = -c.normal;
+      c.shear_force = -c.shear_force;
+    }
+    out.push_back(c);
+  }
+  std::sort(out.begin(), out.end(), [](const ContactInfo& u, const ContactInfo& v) {
+    return u.id_a != v.id_a ? u.id_a < v.id_a : u.id_b < v.id_b;
+  });
+  return out;
+}
+
+std::size_t World::contact_count() const {
+  const auto& q = state_->pairs;
+  std::size_t c = 0;
+  for (std::size_t k = 0; k < q.n; ++k) c += q.overlap[k] > 0;
+  return c;
+}
+
+}  // namespace asperity

@@ -1,0 +1,196 @@
+// The public face of the engine: a World holds particles, walls and rigid groups and advances
+// them in time (model.md sections 1-4, 6, 8). Tests, benchmarks and the Lua layer use only this
+// header (plus vec3.hpp / error.hpp); the stores and kernels behind it live in engine/.
+//
+// Identity: every particle gets a stable id (0, 1, 2, ... in order of creation). Internally the
+// particles are reordered along a space-filling curve for cache locality, so array positions
+// change; every function here speaks in stable ids.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "asperity/error.hpp"
+#include "asperity/vec3.hpp"
+
+namespace asperity {
+
+namespace detail {
+struct State;
+}
+
+// Contact springs and friction (model.md 4). Source values: kn = 0.1 N/m, ks = kn/10, mu = 0.5.
+struct ContactMaterial {
+  double kn = 0.1;         // normal stiffness, N/m
+  double ks = 0.01;        // shear stiffness, N/m
+  double friction = 0.5;   // Coulomb coefficient mu
+};
+
+struct WorldSettings {
+  ContactMaterial contact;          // ball-ball contacts
+  double density = 2500.0;          // kg/m^3, default for add_particle
+  double local_damping = 0.7;       // Cundall alpha, [3-28]
+  Vec3 gravity{0, 0, 0};            // m/s^2
+  bool rotation = true;             // false: no particle rotates (and none pays for rotation)
+  double skin = 0.0;                // Verlet skin, m; 0: 0.4 * mean radius at the first build
+  double dt = 0.0;                  // s; 0: automatic, dt_safety * critical estimate [3-30..3-32]
+  double dt_safety = 0.8;
+  bool allow_dt_above_estimate = false;  // a fixed dt above the estimate is an error unless set
+  int dt_interval = 100;            // steps between critical-step estimates (also at each rebuild)
+  int threads = 0;                  // OpenMP threads; 0: all available
+  std::string simd = "auto";        // "auto", "scalar", "sse4_2", "avx2", "avx512f"
+  bool track_energy = true;         // friction, damping and boundary work ledgers (model.md 8)
+  int reorder_interval = 10;        // neighbour rebuilds between space-filling-curve reorders; 0: never
+};
+
+// How a rigid group's degree of freedom moves (model.md 1).
+enum class Dof : std::uint8_t { free, fixed, velocity };
+
+struct GroupMotion {
+  std::array<Dof, 3> translation{Dof::free, Dof::free, Dof::free};
+  Vec3 velocity{0, 0, 0};          // used on the axes whose mode is Dof::velocity
+  Dof rotation = Dof::fixed;       // all three rotational axes together (the thesis locks them)
+  Vec3 angular_velocity{0, 0, 0};  // used when rotation == Dof::velocity
+};
+
+struct ContactInfo {  // one ball-ball contact (touching pair), for inspection and output
+  std::int64_t id_a, id_b;
+  Vec3 normal;         // unit, from a to b
+  Vec3 point;          // contact point [3-11]
+  double overlap;      // U > 0
+  double normal_force; // Fn >= 0, acting on b along normal
+  Vec3 shear_force;    // Fs on b
+};
+
+struct Energies {            // model.md 8; all in J
+  double kinetic = 0;        // translational + rotational
+  double strain = 0;         // stored in the contact springs
+  double friction = 0;       // dissipated by Coulomb slip (cumulative)
+  double damping = 0;        // dissipated by local damping (cumulative)
+  double boundary_work = 0;  // done on the particles by walls, velocity-prescribed groups and
+                             // applied external forces (cumulative)
+  double gravity_work = 0;   // done by gravity (cumulative)
+  // Input work minus what is stored and dissipated (zero for a perfect balance).
+  double balance_error(const Energies& initial) const;
+};
+
+struct StepStats {
+  std::uint64_t rebuilds = 0;  // neighbour-list rebuilds so far
+  std::uint64_t reorders = 0;  // space-filling-curve reorders so far
+  std::size_t pairs = 0;       // pairs in the neighbour list (touching or not)
+  std::size_t contacts = 0;    // touching ball-ball pairs
+  std::size_t wall_contacts = 0;
+};
+
+class World {
+ public:
+  explicit World(WorldSettings settings = {});
+  ~World();
+  World(World&&) noexcept;
+  World& operator=(World&&) noexcept;
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+
+  const WorldSettings& settings() const;
+
+  // --- particles -------------------------------------------------------------------------
+  // Returns the new particle's stable id. density <= 0 means the world's default.
+  std::int64_t add_particle(Vec3 position, double radius, double density = 0.0);
+  // Bulk: positions as x0,y0,z0,x1,... and one radius each; returns the first id (ids are
+  // consecutive).
+  std::int64_t add_particles(std::span<const double> xyz, std::span<const double> radii,
+                             double density = 0.0);
+  std::size_t particle_count() const;
+
+  Vec3 position(std::int64_t id) const;
+  Vec3 velocity(std::int64_t id) const;          // at the last half step (leapfrog)
+  Vec3 angular_velocity(std::int64_t id) const;
+  Vec3 force(std::int64_t id) const;             // contact + applied force of the last step
+  Vec3 torque(std::int64_t id) const;
+  double radius(std::int64_t id) const;
+  double mass(std::int64_t id) const;
+  int group_of(std::int64_t id) const;           // -1: not in a group
+
+  void set_position(std::int64_t id, Vec3 x);
+  void set_velocity(std::int64_t id, Vec3 v);
+  void set_angular_velocity(std::int64_t id, Vec3 w);
+  void set_radius(std::int64_t id, double r);    // keeps density: mass and inertia follow
+  void set_applied_force(std::int64_t id, Vec3 f);  // constant external force, until reset
+  void set_rotation_locked(std::int64_t id, bool locked);
+  // Multiply every radius by `factor` (radius expansion packing); masses follow.
+  void scale_radii(double factor);
+
+  // Bulk reads in id order: 3 values per particle for vectors.
+  std::vector<double> positions() const;
+  std::vector<double> velocities() const;
+  std::vector<double> forces() const;
+  std::vector<double> radii() const;
+
+  // --- walls -----------------------------------------------------------------------------
+  // An infinite plane through `point`; `normal` points to the side where particles live.
+  int add_plane(Vec3 point, Vec3 normal, ContactMaterial material = {});
+  // A triangle mesh (two-sided). Triangles are binned so that the cost of a step stays
+  // proportional to the particles near the mesh, not to the number of triangles.
+  int add_mesh(std::span<const Vec3> vertices, std::span<const std::array<int, 3>> triangles,
+               ContactMaterial material = {});
+  void set_wall_velocity(int wall, Vec3 v);   // prescribed translation
+  Vec3 wall_velocity(int wall) const;
+  Vec3 wall_displacement(int wall) const;     // since creation
+  Vec3 wall_force(int wall) const;            // force of the particles on the wall, last step
+  void remove_wall(int wall);                 // its contacts vanish; the index stays unused
+  std::size_t wall_count() const;             // including removed ones
+
+  // --- rigid groups ----------------------------------------------------------------------
+  // The particles move as one rigid body; contacts between members are never computed. A
+  // particle belongs to at most one group.
+  int add_group(std::span<const std::int64_t> ids, GroupMotion motion = {});
+  void set_group_motion(int group, const GroupMotion& motion);
+  const GroupMotion& group_motion(int group) const;
+  void set_group_applied_force(int group, Vec3 f);
+  Vec3 group_force(int group) const;       // sum of contact + applied forces on members, last step
+  Vec3 group_torque(int group) const;      // about the centre of mass
+  Vec3 group_position(int group) const;    // centre of mass
+  Vec3 group_velocity(int group) const;
+  double group_mass(int group) const;
+  std::vector<std::int64_t> group_members(int group) const;
+  std::size_t group_count() const;
+
+  // --- running ---------------------------------------------------------------------------
+  // Advance n steps. Returns the number of steps done: fewer than n only if request_stop() was
+  // called (e.g. from a SIGINT handler). Throws HealthError when the run goes wrong.
+  std::uint64_t cycle(std::uint64_t n);
+  void request_stop();                    // async-signal-safe
+  double dt() const;                      // the step in use
+  void set_dt(double dt);                 // fix it (0: back to automatic)
+  double critical_dt();                   // estimate now [3-30..3-32], without safety factor
+  std::uint64_t step_count() const;
+  double time() const;
+  void set_threads(int threads);
+  std::string simd_architecture() const;  // what the kernels use: "avx512f", ..., "scalar"
+  StepStats stats() const;
+  void rebuild_neighbors();               // force a rebuild now (history carried)
+
+  // --- measurements ----------------------------------------------------------------------
+  Energies energies() const;              // kinetic and strain computed now; ledgers cumulative
+  // PFC's equilibrium ratio: mean |unbalanced force| over particles / mean contact normal force.
+  double unbalanced_force_ratio() const;
+  std::vector<ContactInfo> contacts() const;  // touching ball-ball pairs
+  std::size_t contact_count() const;
+
+  // Internal state, for the engine's own tests and the Lua layer's bulk access.
+  detail::State& state() { return *state_; }
+  const detail::State& state() const { return *state_; }
+
+ private:
+  std::unique_ptr<detail::State> state_;
+};
+
+// Architectures the running CPU supports, best first, always ending with "scalar".
+std::vector<std::string> available_simd_architectures();
+
+}  // namespace asperity

@@ -1,0 +1,135 @@
+// Results do not depend on the thread count, and the SIMD kernels equal the scalar reference.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <random>
+
+#include "core/aligned.hpp"
+#include "kernels/kernels.hpp"
+#include "scenes.hpp"
+
+using namespace asperity;
+
+TEST(Determinism, FullStateBitwiseIdenticalWithOneAndTwoThreads) {
+  WorldSettings one, two;
+  one.threads = 1;
+  two.threads = 2;
+  World a = test::random_box(3000, one), b = test::random_box(3000, two);
+  a.cycle(1500);
+  b.cycle(1500);
+  ASSERT_GT(a.contact_count(), 1000u);
+  auto same = [](const std::vector<double>& u, const std::vector<double>& v) {
+    return u.size() == v.size() && std::memcmp(u.data(), v.data(), u.size() * sizeof(double)) == 0;
+  };
+  EXPECT_TRUE(same(a.positions(), b.positions()));
+  EXPECT_TRUE(same(a.velocities(), b.velocities()));
+  EXPECT_TRUE(same(a.forces(), b.forces()));
+  const Energies ea = a.energies(), eb = b.energies();
+  EXPECT_EQ(ea.friction, eb.friction);
+  EXPECT_EQ(ea.damping, eb.damping);
+  EXPECT_EQ(ea.strain, eb.strain);
+}
+
+TEST(Determinism, SameSeedSameRun) {
+  World a = test::random_box(500), b = test::random_box(500);
+  a.cycle(1000);
+  b.cycle(1000);
+  const auto pa = a.positions(), pb = b.positions();
+  EXPECT_EQ(0, std::memcmp(pa.data(), pb.data(), pa.size() * sizeof(double)));
+}
+
+namespace {
+// Random pairs in every state: touching, apart, sliding, sticking, spinning, fresh (zero history).
+struct RandomPairs {
+  std::vector<double, AlignedAllocator<double>> x, y, z, vx, vy, vz, wx, wy, wz, r;
+  std::vector<std::int64_t, AlignedAllocator<std::int64_t>> a, b;
+  std::vector<double, AlignedAllocator<double>> nx, ny, nz, fsx, fsy, fsz, fn, U;
+  explicit RandomPairs(std::size_t pairs, unsigned seed) {
+    const std::size_t n = 2 * pairs;
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (auto* c : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &r}) c->resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      r[i] = 5e-4 * (1 + 0.3 * u(rng));
+      vx[i] = 1e-3 * u(rng); vy[i] = 1e-3 * u(rng); vz[i] = 1e-3 * u(rng);
+      wx[i] = u(rng); wy[i] = u(rng); wz[i] = u(rng);
+    }
+    a.resize(pairs); b.resize(pairs);
+    for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &U}) c->resize(pairs);
+    for (std::size_t k = 0; k < pairs; ++k) {
+      a[k] = std::int64_t(2 * k);
+      b[k] = std::int64_t(2 * k + 1);
+      x[2 * k] = u(rng); y[2 * k] = u(rng); z[2 * k] = u(rng);
+      Vec3 dir{u(rng), u(rng), u(rng)};
+      dir = dir / norm(dir);
+      const double d = (r[2 * k] + r[2 * k + 1]) * (1 + 0.05 * u(rng));
+      x[2 * k + 1] = x[2 * k] + d * dir.x; y[2 * k + 1] = y[2 * k] + d * dir.y; z[2 * k + 1] = z[2 * k] + d * dir.z;
+      Vec3 old = dir + Vec3{0.01 * u(rng), 0.01 * u(rng), 0.01 * u(rng)};
+      old = old / norm(old);
+      nx[k] = old.x; ny[k] = old.y; nz[k] = old.z;
+      const double s = (k % 5 == 0) ? 0.0 : 1e-5;
+      fsx[k] = s * u(rng); fsy[k] = s * u(rng); fsz[k] = s * u(rng);
+    }
+  }
+  kernels::PairKernelArgs args() {
+    return {x.data(), y.data(), z.data(), vx.data(), vy.data(), vz.data(), wx.data(), wy.data(),
+            wz.data(), r.data(), a.data(), b.data(), nx.data(), ny.data(), nz.data(), fsx.data(),
+            fsy.data(), fsz.data(), fn.data(), U.data(), 0.1, 0.01, 0.5, 1e-3};
+  }
+};
+}  // namespace
+
+TEST(Determinism, SimdKernelsEqualTheScalarReferenceBitwise) {
+  const std::size_t pairs = 4096;
+  const auto archs = available_simd_architectures();
+  ASSERT_EQ(archs.back(), "scalar");
+  for (const auto& arch : archs) {
+    const auto& simd = kernels::select_kernels(arch);
+    for (bool rotation : {true, false}) {
+      RandomPairs ref(pairs, 11), got(pairs, 11);
+      const auto& sk = kernels::scalar_kernels();
+      const double slip_ref = (rotation ? sk.pair : sk.pair_norot)(ref.args(), 0, pairs);
+      const double slip_got = (rotation ? simd.pair : simd.pair_norot)(got.args(), 0, pairs);
+      auto same = [&](const auto& u, const auto& v) {
+        return std::memcmp(u.data(), v.data(), pairs * sizeof(double)) == 0;
+      };
+      EXPECT_TRUE(same(ref.fn, got.fn)) << arch;
+      EXPECT_TRUE(same(ref.U, got.U)) << arch;
+      EXPECT_TRUE(same(ref.nx, got.nx) && same(ref.ny, got.ny) && same(ref.nz, got.nz)) << arch;
+      EXPECT_TRUE(same(ref.fsx, got.fsx) && same(ref.fsy, got.fsy) && same(ref.fsz, got.fsz)) << arch;
+      // The slip energy is summed per lane first: equal to rounding.
+      EXPECT_NEAR(slip_got, slip_ref, 1e-12 * slip_ref) << arch;
+      ASSERT_GT(slip_ref, 0.0) << "the random pairs must include slipping contacts";
+      std::size_t touching = 0;
+      for (double u : ref.U) touching += u > 0;
+      EXPECT_GT(touching, pairs / 4);
+      EXPECT_LT(touching, 3 * pairs / 4);
+    }
+  }
+}
+
+TEST(Determinism, WholeRunSameWithEveryArchitecture) {
+  std::vector<double> reference;
+  for (const auto& arch : available_simd_architectures()) {
+    WorldSettings ws;
+    ws.simd = arch;
+    World w = test::random_box(500, ws);
+    EXPECT_EQ(w.simd_architecture(), arch);
+    w.cycle(500);
+    const auto p = w.positions();
+    if (reference.empty()) reference = p;
+    else EXPECT_EQ(0, std::memcmp(p.data(), reference.data(), p.size() * sizeof(double))) << arch;
+  }
+}
+
+TEST(Determinism, UnknownArchitectureIsAClearError) {
+  WorldSettings ws;
+  ws.simd = "neon";
+  try {
+    World w(ws);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("neon"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("scalar"), std::string::npos) << "lists the valid ones";
+  }
+}

@@ -1,0 +1,54 @@
+// Coulomb friction [3-22]: a sphere (rotation locked) pressed on a plane by N and pulled
+// tangentially by T sticks for T < mu N (held by the shear spring at T / ks) and slides for
+// T > mu N with acceleration (T - mu N) / m.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "asperity/world.hpp"
+
+using namespace asperity;
+
+namespace {
+constexpr double kR = 5e-4, kN = 1e-5, kMu = 0.5;
+
+World sphere_on_plane(double tangential, double damping, std::int64_t& id) {
+  WorldSettings ws;
+  ws.local_damping = damping;
+  ws.rotation = false;
+  World w(ws);
+  w.add_plane({0, 0, 0}, {0, 0, 1});
+  id = w.add_particle({0, 0, kR - kN / 0.1}, kR);
+  w.set_applied_force(id, {tangential, 0, -kN});
+  w.set_dt(0.05 * w.critical_dt());
+  return w;
+}
+}  // namespace
+
+TEST(Friction, SticksBelowTheCoulombLimit) {
+  // Applied at once, the load overshoots: with local damping alpha the first peak of the shear
+  // spring is (1 + sqrt((1 - alpha) / (1 + alpha))) T = 1.42 T, so T = 0.6 mu N never slips
+  // (0.9 mu N does, briefly, and correctly).
+  const double T = 0.6 * kMu * kN;
+  std::int64_t id;
+  World w = sphere_on_plane(T, 0.7, id);
+  w.cycle(40000);
+  EXPECT_NEAR(w.position(id).x, T / 0.01, 1e-6 * T / 0.01) << "held by the shear spring at T/ks";
+  EXPECT_NEAR(w.velocity(id).x, 0.0, 1e-9);
+  EXPECT_NEAR(w.wall_force(0).x, T, 1e-9 * T) << "the plane holds the full tangential force";
+  EXPECT_EQ(w.energies().friction, 0.0) << "no slip, no friction dissipation";
+}
+
+TEST(Friction, SlidesAboveTheCoulombLimit) {
+  const double T = 1.5 * kMu * kN;
+  std::int64_t id;
+  World w = sphere_on_plane(T, 0.0, id);
+  w.cycle(500);  // sliding by now
+  const double v1 = w.velocity(id).x, t1 = w.time();
+  w.cycle(1000);
+  const double v2 = w.velocity(id).x, t2 = w.time();
+  EXPECT_NEAR(w.wall_force(0).x, kMu * kN, 1e-12 * kMu * kN) << "shear force capped at mu N";
+  const double accel = (T - kMu * kN) / w.mass(id);
+  EXPECT_NEAR((v2 - v1) / (t2 - t1), accel, 1e-6 * accel);
+  EXPECT_GT(w.energies().friction, 0.0);
+}

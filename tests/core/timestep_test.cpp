@@ -1,0 +1,127 @@
+// Critical time step (model.md 3) and the health checks around it.
+//
+// The estimate sqrt(m / k_tran) with k_tran summed over a body's contacts is conservative: for a
+// chain, whose highest mode has omega = 2 sqrt(kn/m), leapfrog is stable up to dt = sqrt(m/kn),
+// which is sqrt(2) times the estimate sqrt(m / 2kn) of an interior particle (by Gershgorin's
+// theorem no contact network can be tighter than that factor). So a chain at 1.2x the estimate
+// does not blow up by itself: the engine refuses the step because dt is above the estimate. Beyond
+// sqrt(2)x, with the refusal switched off, the chain does blow up, and the runaway check sees it.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "asperity/world.hpp"
+
+using namespace asperity;
+
+namespace {
+World chain(int n, bool allow) {
+  WorldSettings ws;
+  ws.local_damping = 0;
+  ws.rotation = false;
+  ws.contact.friction = 0;
+  ws.allow_dt_above_estimate = allow;
+  World w(ws);
+  // Spheres 0.02 mm into each other and into two end planes: every contact stays closed for the
+  // small velocities given, so the chain is a fixed-fixed mass-spring chain.
+  const double R = 5e-4, a = 0.98e-3;
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < n; ++i) {
+    const auto id = w.add_particle({i * a, 0, 0}, R);
+    w.set_velocity(id, {1e-4 * u(rng), 0, 0});
+  }
+  ContactMaterial frictionless;
+  frictionless.friction = 0;
+  w.add_plane({-a / 2, 0, 0}, {1, 0, 0}, frictionless);
+  w.add_plane({(n - 0.5) * a, 0, 0}, {-1, 0, 0}, frictionless);
+  return w;
+}
+}  // namespace
+
+TEST(TimeStep, EstimateIsSqrtMassOverContactStiffness) {
+  World w = chain(10, false);
+  const double m = w.mass(0);
+  // Interior particles have two contacts: sqrt(m / (2 kn)).
+  EXPECT_NEAR(w.critical_dt(), std::sqrt(m / (2 * 0.1)), 1e-15);
+  w.cycle(1);
+  EXPECT_NEAR(w.dt(), 0.8 * std::sqrt(m / (2 * 0.1)), 1e-15) << "automatic dt = 0.8 x estimate";
+}
+
+TEST(TimeStep, ChainRunsStablyAtNinetyFivePercent) {
+  World w = chain(20, false);
+  const double est = w.critical_dt();
+  w.set_dt(0.95 * est);
+  w.cycle(1);
+  const Energies e0 = w.energies();
+  EXPECT_NO_THROW(w.cycle(50000));
+  const Energies e = w.energies();
+  EXPECT_NEAR((e.kinetic + e.strain) / (e0.kinetic + e0.strain), 1.0, 0.05);
+}
+
+TEST(TimeStep, AboveTheEstimateIsRefused) {
+  World w = chain(20, false);
+  const double est = w.critical_dt();
+  w.set_dt(1.2 * est);
+  try {
+    w.cycle(10);
+    FAIL() << "dt at 1.2x the estimate must be refused";
+  } catch (const HealthError& e) {
+    EXPECT_EQ(e.quantity, "dt");
+    EXPECT_NEAR(e.value, 1.2 * est, 1e-18);
+    EXPECT_NE(std::string(e.what()).find("critical estimate"), std::string::npos);
+  }
+}
+
+TEST(TimeStep, BeyondTheTrueLimitTheBlowUpIsDetected) {
+  World w = chain(20, true);
+  const double est = w.critical_dt();
+  // Stable just below the true limit sqrt(2) x estimate ...
+  w.set_dt(1.3 * est);
+  EXPECT_NO_THROW(w.cycle(20000));
+  // ... and detected within a few hundred steps beyond it.
+  World v = chain(20, true);
+  v.set_dt(1.6 * est);
+  std::uint64_t detected_at = 0;
+  try {
+    v.cycle(20000);
+  } catch (const HealthError& e) {
+    detected_at = e.step;
+    EXPECT_GE(e.particle_id >= 0 || e.quantity == "kinetic + strain energy", true);
+  }
+  EXPECT_GT(detected_at, 0u) << "the runaway must be detected";
+  EXPECT_LT(detected_at, 2000u);
+}
+
+TEST(TimeStep, DampingRatioOfOneDegreeOfFreedom) {
+  // A sphere pressed into a plane by a constant force oscillates about U0 = F/kn. Local damping
+  // reduces the force by alpha while accelerating and raises it while decelerating, so successive
+  // extrema (on opposite sides) shrink by sqrt((1 - alpha) / (1 + alpha)) [3-28].
+  for (double alpha : {0.1, 0.3, 0.7}) {
+    WorldSettings ws;
+    ws.local_damping = alpha;
+    ws.rotation = false;
+    World w(ws);
+    const double R = 5e-4, F = 1e-5, U0 = F / 0.1;
+    w.add_plane({0, 0, 0}, {0, 0, 1});
+    const auto id = w.add_particle({0, 0, R - 1.5 * U0}, R);  // amplitude 0.5 U0
+    w.set_applied_force(id, {0, 0, -F});
+    const double T = 2 * std::acos(-1.0) * std::sqrt(w.mass(id) / 0.1);
+    w.set_dt(T / 4000);
+    std::vector<double> extrema;
+    double prev = w.position(id).z - (R - U0), prev2 = prev;
+    for (int k = 0; k < 4000 * 4 && extrema.size() < 4; ++k) {
+      w.cycle(1);
+      const double x = w.position(id).z - (R - U0);
+      if ((prev > prev2 && prev >= x) || (prev < prev2 && prev <= x)) extrema.push_back(prev);
+      prev2 = prev;
+      prev = x;
+    }
+    ASSERT_GE(extrema.size(), 3u);
+    const double expected = std::sqrt((1 - alpha) / (1 + alpha));
+    for (std::size_t k = 1; k < extrema.size(); ++k)
+      EXPECT_NEAR(std::fabs(extrema[k] / extrema[k - 1]), expected, 2e-3)
+          << "alpha " << alpha << " extremum " << k;
+  }
+}
