@@ -135,7 +135,7 @@ double estimate_critical_dt(const State& s) {
   for (const Group& g : s.groups) {  // a group is one body
     double k = 0;
     for (std::int32_t i : g.members) k += ktran[i];
-    if (k > 0) best = std::min(best, std::sqrt(g.mass / k));
+    if (!g.members.empty()) best = std::min(best, std::sqrt(g.mass / (k > 0 ? k : kc)));
   }
   for (std::size_t i = 0; i < n; ++i) {
     if (p.group[i] >= 0) continue;

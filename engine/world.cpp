@@ -355,6 +355,16 @@ int World::add_mesh(std::span<const Vec3> vertices, std::span<const std::array<i
       if (vertex_owner[a] == t) mesh.owns[t] |= std::uint8_t(1 << (3 + k));
     }
   }
+  mesh.vertex_start.assign(vertices.size() + 1, 0);
+  for (const auto& tri : triangles)
+    for (int k = 0; k < 3; ++k) ++mesh.vertex_start[tri[k] + 1];
+  for (std::size_t v = 0; v < vertices.size(); ++v) mesh.vertex_start[v + 1] += mesh.vertex_start[v];
+  mesh.vertex_triangles.resize(mesh.vertex_start.back());
+  {
+    std::vector<std::int32_t> fill(mesh.vertex_start.begin(), mesh.vertex_start.end() - 1);
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+      for (int k = 0; k < 3; ++k) mesh.vertex_triangles[fill[triangles[t][k]]++] = std::int32_t(t);
+  }
   detail::bin_mesh(mesh);
   state_->walls.meshes.push_back(std::move(mesh));
   detail::Wall w;

@@ -121,6 +121,38 @@ void query_mesh(const Mesh& mesh, const Vec3& q, double reach, std::vector<std::
 namespace {
 // Feature code -> ownership bit (see Mesh::owns).
 constexpr std::uint8_t kFeatureBit[7] = {0, 1 << 3, 1 << 4, 1 << 5, 1 << 0, 1 << 1, 1 << 2};
+
+// Whether a contact whose closest point lies on an edge or a vertex of triangle t is a real
+// contact: it is the shadow of another one when a triangle sharing that edge or vertex comes
+// closer to the sphere (a sphere over a flat mesh touches one face; the neighbouring triangles'
+// edges are also within reach but are not contacts). Among equally close triangles (a convex
+// ridge or peak, where they all share the closest point) the owner of the feature counts it once.
+bool mesh_feature_contact_is_real(const Mesh& mesh, int t, int feature, const Vec3& q, double d) {
+  if (!(mesh.owns[t] & kFeatureBit[feature])) {
+    // Not the owner: the owner (or a closer triangle) accounts for it.
+    return false;
+  }
+  const auto& tri = mesh.triangles[t];
+  int va, vb = -1;  // the vertex, or the two vertices of the edge
+  if (feature <= 3) {
+    va = tri[feature - 1];
+  } else {
+    va = tri[feature - 4];
+    vb = tri[(feature - 3) % 3];
+  }
+  const double limit = d * (1 - 1e-9);
+  for (std::int32_t k = mesh.vertex_start[va]; k < mesh.vertex_start[va + 1]; ++k) {
+    const std::int32_t o = mesh.vertex_triangles[k];
+    if (o == t) continue;
+    const auto& ot = mesh.triangles[o];
+    if (vb >= 0 && ot[0] != vb && ot[1] != vb && ot[2] != vb) continue;  // does not share the edge
+    int f;
+    const Vec3 cp = closest_point_on_triangle(q, mesh.vertices[ot[0]], mesh.vertices[ot[1]],
+                                              mesh.vertices[ot[2]], f);
+    if (norm(q - cp) < limit) return false;
+  }
+  return true;
+}
 }  // namespace
 
 void compute_wall_forces(State& s) {
@@ -159,7 +191,7 @@ void compute_wall_forces(State& s) {
         const double d = norm(dv);
         n = d > 0 ? dv / d : Vec3{0, 0, 1};
         U = p.radius[i] - d;
-        active = feature == 0 || (mesh.owns[wc.facet[k]] & kFeatureBit[feature]);
+        active = feature == 0 || mesh_feature_contact_is_real(mesh, wc.facet[k], feature, q, d);
       }
       if (!active) U = -1.0;  // not this triangle's contact: no force, history dropped
       Vec3 o{wc.nx[k], wc.ny[k], wc.nz[k]};

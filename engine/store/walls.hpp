@@ -28,6 +28,10 @@ struct Mesh {
   // closest point lies on an edge or vertex shared by several triangles counts only for the owner
   // (the lowest-numbered triangle sharing it), so a sphere on a fold is pushed once, not twice.
   std::vector<std::uint8_t> owns;
+  // Triangles around each vertex (CSR): a contact on an edge or vertex is real only if no
+  // triangle sharing that feature is closer to the sphere (otherwise that triangle's face or
+  // edge is the contact, and this one is its shadow).
+  std::vector<std::int32_t> vertex_start, vertex_triangles;
   TriangleBins bins;
 };
 

@@ -1,0 +1,122 @@
+// Rigid groups (model.md 1): prescribed, fixed and free degrees of freedom; member contacts
+// excluded; boundary work of the agent that drives them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "asperity/world.hpp"
+
+using namespace asperity;
+
+namespace {
+std::vector<std::int64_t> slab(World& w, int n, double z, double R) {
+  std::vector<std::int64_t> ids;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) ids.push_back(w.add_particle({i * 1.9 * R, j * 1.9 * R, z}, R));
+  return ids;  // neighbours overlap by 0.1 R: their contacts must not be computed
+}
+}  // namespace
+
+TEST(Groups, MemberContactsAreNeverComputed) {
+  World w;
+  const auto ids = slab(w, 4, 0, 5e-4);
+  w.add_group(ids, GroupMotion{{Dof::fixed, Dof::fixed, Dof::fixed}});
+  w.cycle(10);
+  EXPECT_EQ(w.stats().pairs, 0u);
+  EXPECT_EQ(w.contact_count(), 0u);
+}
+
+TEST(Groups, PrescribedVelocityIsFollowedExactly) {
+  World w;
+  const auto ids = slab(w, 3, 0, 5e-4);
+  GroupMotion m;
+  m.translation = {Dof::velocity, Dof::fixed, Dof::velocity};
+  m.velocity = {2e-5, 7, -1e-5};  // y is fixed: its velocity is ignored
+  const int g = w.add_group(ids, m);
+  const Vec3 c0 = w.group_position(g), p0 = w.position(ids[4]);
+  w.cycle(1000);
+  const double t = w.time();
+  EXPECT_NEAR(w.group_position(g).x - c0.x, 2e-5 * t, 1e-15);
+  EXPECT_EQ(w.group_position(g).y, c0.y);
+  EXPECT_NEAR(w.group_position(g).z - c0.z, -1e-5 * t, 1e-15);
+  EXPECT_NEAR(w.position(ids[4]).x - p0.x, 2e-5 * t, 1e-15) << "members move with the group";
+  EXPECT_EQ(w.velocity(ids[4]).x, 2e-5);
+}
+
+TEST(Groups, FreeGroupFallsWithGravityAndPlatenForceIsTheContactSum) {
+  WorldSettings ws;
+  ws.gravity = {0, 0, -0.01};
+  ws.local_damping = 0;
+  World w(ws);
+  const auto ids = slab(w, 3, 0, 5e-4);
+  const int g = w.add_group(ids);
+  const double z0 = w.group_position(g).z;
+  const int n = 500;
+  w.cycle(n);
+  // Leapfrog from rest: z_n = z_0 - g dt^2 n (n + 1) / 2 exactly.
+  const double drop = 0.01 * w.dt() * w.dt() * n * (n + 1) / 2;
+  EXPECT_NEAR(w.group_position(g).z - z0, -drop, 1e-12 * drop);
+  EXPECT_NEAR(w.group_velocity(g).z, -0.01 * w.dt() * n, 1e-12);
+  EXPECT_NEAR(w.group_mass(g), 9 * w.mass(ids[0]), 1e-20);
+}
+
+TEST(Groups, PlatenPressingASphereOnAFloor) {
+  // A platen group pushed down by an applied force onto a sphere lying on a floor: at rest, the
+  // group's contact force balances the applied force and the floor carries it.
+  WorldSettings ws;
+  ws.rotation = false;
+  World w(ws);
+  const double R = 5e-4;
+  w.add_plane({0, 0, 0}, {0, 0, 1});
+  w.add_particle({0, 0, R}, R);
+  const auto ids = slab(w, 3, 3 * R, R);
+  std::vector<std::int64_t> centred;
+  for (auto id : ids) centred.push_back(id);
+  GroupMotion m;
+  m.translation = {Dof::fixed, Dof::fixed, Dof::free};
+  const int g = w.add_group(centred, m);
+  // Centre the platen over the sphere.
+  (void)g;
+  w.set_group_applied_force(g, {0, 0, -2e-5});
+  w.cycle(20000);
+  EXPECT_NEAR(w.group_force(g).z, 0.0, 1e-9) << "contact force balances the applied force";
+  EXPECT_NEAR(w.wall_force(0).z, -2e-5, 1e-9);
+}
+
+TEST(Groups, DrivenGroupEnergyBalance) {
+  // A platen pushed at constant velocity into a column of spheres on a floor: the agent's work
+  // equals what is stored and dissipated.
+  WorldSettings ws;
+  World w(ws);
+  const double R = 5e-4;
+  w.add_plane({0, 0, 0}, {0, 0, 1});
+  for (int k = 0; k < 4; ++k) w.add_particle({0, 0, R + k * 2 * R * 0.999}, R);
+  const auto platen = slab(w, 2, 9.01 * R, R);  // just above the top sphere
+  GroupMotion m;
+  m.translation = {Dof::fixed, Dof::fixed, Dof::velocity};
+  m.velocity = {0, 0, -2e-6};
+  const int g = w.add_group(platen, m);
+  w.cycle(5);
+  const Energies e0 = w.energies();
+  w.cycle(30000);
+  const Energies e = w.energies();
+  const double input = e.boundary_work - e0.boundary_work;
+  ASSERT_GT(input, 0);
+  EXPECT_LT(std::fabs(e.balance_error(e0)), 0.01 * input);
+  EXPECT_GT(w.group_force(g).z, 0) << "the column pushes back";
+}
+
+TEST(Groups, BadInputIsRefusedWithAReason) {
+  World w;
+  const auto a = w.add_particle({0, 0, 0}, 5e-4);
+  w.add_group(std::vector<std::int64_t>{a});
+  try {
+    w.add_group(std::vector<std::int64_t>{a});
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("already belongs to group 0"), std::string::npos);
+  }
+  EXPECT_THROW(w.add_group(std::vector<std::int64_t>{42}), Error);
+  EXPECT_THROW(w.group_force(3), Error);
+  EXPECT_THROW(w.set_velocity(a, {1, 0, 0}), Error) << "members move with their group";
+}
