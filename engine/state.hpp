@@ -7,6 +7,7 @@
 
 #include "asperity/world.hpp"
 #include "kernels/kernels.hpp"
+#include "store/bonds.hpp"
 #include "store/pairs.hpp"
 #include "store/particles.hpp"
 #include "store/walls.hpp"
@@ -24,7 +25,7 @@ struct Group {
 
 // Cumulative ledgers of model.md 8 (kinetic and strain are computed on demand).
 struct Ledger {
-  double friction = 0, damping = 0, boundary = 0, gravity = 0;
+  double friction = 0, damping = 0, boundary = 0, gravity = 0, released = 0;
 };
 
 // Work units: pairs and particles are processed in fixed blocks; per-block partial sums are
@@ -47,6 +48,17 @@ struct State {
   Incidence incidence;
   WallStore walls;
   std::vector<Group> groups;
+  BondStore bonds;
+  Incidence bond_incidence;
+  // Bonded partners per particle (CSR, sorted): the neighbour search leaves bonded pairs out.
+  std::vector<std::int32_t> partner_start, partners;
+  // Contacts that a broken bond leaves behind (overlapping pairs with their capped shear force):
+  // merged into the pair list at the next rebuild, which a break always triggers.
+  PairStore inherited;
+  std::vector<BreakEvent> break_events;
+  std::vector<double> bond_block_breaks;
+  std::vector<std::uint8_t> user_rotation_locked;  // set by the API; bonds add their own lock
+  bool any_rotating = true;  // some particle can rotate: kernels read angular velocities
   const kernels::KernelSet* kernels = nullptr;
 
   double dt = 0;             // in use
@@ -79,6 +91,12 @@ struct State {
 void build_neighbors(State& s);         // neighbor/build.cpp
 void compute_pair_forces(State& s);     // kernels/pairs.cpp
 void compute_wall_forces(State& s);     // kernels/walls.cpp
+void compute_bond_forces(State& s);     // kernels/bonds.cpp
+void process_breaks(State& s);          // kernels/bonds.cpp: events, energy, compaction
+void refresh_bond_topology(State& s);   // kernels/bonds.cpp: incidence, partners, rotation locks
+// CSR of the pairs (a, b) per particle, entries (k << 1) | (particle is b), ascending k.
+void build_incidence(std::size_t particles, const std::int64_t* a, const std::int64_t* b,
+                     std::size_t count, Incidence& inc);
 void gather_and_integrate(State& s);    // kernels/integrate.cpp
 void advance_groups(State& s);          // bodies/groups.cpp
 double estimate_critical_dt(const State& s);  // step.cpp

@@ -1,11 +1,11 @@
 // One step, in named stages (design.md "One step"):
 //   1 neighbors   rebuild the pair list when something moved more than skin/2 (history carried)
 //   2 contacts    pair kernel -> per-pair normal, shear force, normal force, overlap
-//   3 walls       ball-wall kernel -> per-contact results, wall forces, wall work
-//   4+7 gather and integrate (fused) -> particle forces; free particles advanced
+//   3 bonds       bond kernel -> per-bond forces, moments, break flags
+//   4 walls       ball-wall kernel -> per-contact results, wall forces, wall work
+//   5+7 gather and integrate (fused) -> particle forces; free particles advanced
 //   6 groups      rigid groups advanced, members moved
-//   8 bookkeep    ledgers, health checks, rebuild criterion, time-step estimate
-// (Stage 5, bonds, arrives with the bonded-particle model.)
+//   8 bookkeep    ledgers, health checks, rebuild criterion, breaks, time-step estimate
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -121,6 +121,21 @@ double estimate_critical_dt(const State& s) {
     krot[a] += m.ks * la * la;
     krot[b] += m.ks * lb * lb;
   }
+  // Bonds [3-31, 3-32]: contact springs plus the beam, k_rot += kbn I + kbs J.
+  const BondStore& bq = s.bonds;
+  const BondMaterial& bm = bq.material;
+  for (std::size_t k = 0; k < bq.n; ++k) {
+    const auto a = bq.a[k], b = bq.b[k];
+    const double kt = kc + std::max(bm.beam_kn, bm.beam_ks);
+    ktran[a] += kt;
+    ktran[b] += kt;
+    const double r2 = bq.beam_radius[k] * bq.beam_radius[k];
+    const double beam_rot = bm.beam_kn * 0.25 * r2 + bm.beam_ks * 0.5 * r2;
+    const double U = bq.overlap[k];
+    const double la = p.radius[a] - 0.5 * U, lb = p.radius[b] - 0.5 * U;
+    krot[a] += (m.ks + bm.beam_ks) * la * la + beam_rot;
+    krot[b] += (m.ks + bm.beam_ks) * lb * lb + beam_rot;
+  }
   const WallContacts& wc = s.walls.contacts;
   for (std::size_t k = 0; k < wc.n; ++k) {
     const double U = wc.overlap[k];
@@ -141,7 +156,7 @@ double estimate_critical_dt(const State& s) {
     if (p.group[i] >= 0) continue;
     const double kt = ktran[i] > 0 ? ktran[i] : kc;
     best = std::min(best, std::sqrt(p.mass[i] / kt));
-    if (s.settings.rotation && !p.rotation_locked[i]) {
+    if (!p.rotation_locked[i]) {
       const double kr = krot[i] > 0 ? krot[i] : m.ks * p.radius[i] * p.radius[i];
       best = std::min(best, std::sqrt(p.inertia[i] / kr));
     }
@@ -173,6 +188,19 @@ Energies compute_energies(const State& s) {
     e.strain += wc.fn[k] * wc.fn[k] / (2 * wm.kn) +
                 (wc.fsx[k] * wc.fsx[k] + wc.fsy[k] * wc.fsy[k] + wc.fsz[k] * wc.fsz[k]) / (2 * wm.ks);
   }
+  const BondStore& bq = s.bonds;
+  const BondMaterial& bm = bq.material;
+  for (std::size_t k = 0; k < bq.n; ++k) {
+    const double r2 = bq.beam_radius[k] * bq.beam_radius[k];
+    e.strain += bq.fn[k] * bq.fn[k] / (2 * m.kn) +
+                (bq.fsx[k] * bq.fsx[k] + bq.fsy[k] * bq.fsy[k] + bq.fsz[k] * bq.fsz[k]) / (2 * m.ks) +
+                bq.fbn[k] * bq.fbn[k] / (2 * bm.beam_kn) +
+                (bq.fbsx[k] * bq.fbsx[k] + bq.fbsy[k] * bq.fbsy[k] + bq.fbsz[k] * bq.fbsz[k]) / (2 * bm.beam_ks) +
+                bq.mbn[k] * bq.mbn[k] / (2 * bm.beam_ks * 0.5 * r2) +
+                (bq.mbsx[k] * bq.mbsx[k] + bq.mbsy[k] * bq.mbsy[k] + bq.mbsz[k] * bq.mbsz[k]) /
+                    (2 * bm.beam_kn * 0.25 * r2);
+  }
+  e.released = s.ledger.released;
   e.friction = s.ledger.friction;
   e.damping = s.ledger.damping;
   e.boundary_work = s.ledger.boundary;
@@ -186,6 +214,7 @@ void step_once(State& s) {
   const bool estimate_due = s.step >= s.last_estimate_step + std::uint64_t(s.settings.dt_interval);
   if (rebuilt || estimate_due || s.dt <= 0) check_dt(s);
   compute_pair_forces(s);
+  compute_bond_forces(s);
   compute_wall_forces(s);
   gather_and_integrate(s);
   advance_groups(s);
@@ -193,6 +222,7 @@ void step_once(State& s) {
   ++s.step;
   s.time += s.dt;
   bookkeep(s);
+  process_breaks(s);  // after the step: broken bonds acted with the forces of their last state
   s.kinetic_valid = true;
   if (estimate_due) check_energy(s);
 }

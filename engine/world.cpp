@@ -10,6 +10,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "kernels/bond_law.hpp"
 #include "state.hpp"
 
 namespace asperity {
@@ -71,7 +72,8 @@ void recompute_group(State& s, detail::Group& g) {
 double Energies::balance_error(const Energies& initial) const {
   const double input = (boundary_work - initial.boundary_work) + (gravity_work - initial.gravity_work);
   const double out = (kinetic - initial.kinetic) + (strain - initial.strain) +
-                     (friction - initial.friction) + (damping - initial.damping);
+                     (friction - initial.friction) + (damping - initial.damping) +
+                     (released - initial.released);
   return input - out;
 }
 
@@ -97,6 +99,10 @@ World::World(WorldSettings settings) : state_(std::make_unique<State>()) {
   s.p.resize(0);
   s.pairs.resize(0);
   s.pairs.fill_padding(s.p.null_a(), s.p.null_b());
+  s.bonds.resize(0);
+  s.bonds.fill_padding(s.p.null_a(), s.p.null_b());
+  s.partner_start.assign(1, 0);
+  s.any_rotating = settings.rotation;
 }
 
 World::~World() = default;
@@ -163,6 +169,11 @@ std::int64_t World::add_particles(std::span<const double> xyz, std::span<const d
     p.id[i] = first_id + std::int64_t(k);
     p.index_of_id.push_back(std::int64_t(i));
   }
+  s.user_rotation_locked.resize(p.n, 0);
+  s.partner_start.resize(p.n + 1, s.partner_start.empty() ? 0 : s.partner_start.back());
+  s.any_rotating = s.any_rotating || s.settings.rotation;
+  // Bond and pair padding point at null particles, whose indices moved with the new count.
+  s.bonds.fill_padding(p.null_a(), p.null_b());
   s.force_reorder = true;
   touch(s);
   return first_id;
@@ -275,8 +286,8 @@ void World::set_rotation_locked(std::int64_t id, bool locked) {
   const auto i = index_of(*state_, id);
   require(state_->settings.rotation || locked,
           "rotation is disabled in this world (settings.rotation = false)");
-  p.rotation_locked[i] = locked ? 1 : 0;
-  if (locked) p.wx[i] = p.wy[i] = p.wz[i] = 0;
+  state_->user_rotation_locked[i] = locked ? 1 : 0;
+  detail::refresh_bond_topology(*state_);
 }
 
 namespace {
@@ -441,6 +452,132 @@ std::vector<std::int64_t> World::group_members(int group) const {
   return out;
 }
 std::size_t World::group_count() const { return state_->groups.size(); }
+
+// --- bonds ---------------------------------------------------------------------------------
+
+std::size_t World::install_bonds(const BondMaterial& material, double tolerance,
+                                 std::span<const std::int64_t> ids) {
+  State& s = *state_;
+  require(material.beam_kn > 0 && std::isfinite(material.beam_kn),
+          "bond material: beam_kn must be > 0, got " + num(material.beam_kn));
+  require(material.beam_ks > 0 && std::isfinite(material.beam_ks),
+          "bond material: beam_ks must be > 0, got " + num(material.beam_ks));
+  require(material.radius_factor > 0 && std::isfinite(material.radius_factor),
+          "bond material: radius_factor must be > 0, got " + num(material.radius_factor));
+  require(!material.breakable || (material.tensile_strength > 0 && std::isfinite(material.tensile_strength)),
+          "bond material: a breakable bond needs tensile_strength > 0 (Pa), got " +
+              num(material.tensile_strength) + "; set breakable = false for unbreakable bonds");
+  if (s.bonds.n > 0) {
+    const BondMaterial& m = s.bonds.material;
+    require(m.beam_kn == material.beam_kn && m.beam_ks == material.beam_ks &&
+                m.radius_factor == material.radius_factor &&
+                m.tensile_strength == material.tensile_strength && m.breakable == material.breakable,
+            "install_bonds: the world already holds bonds of another material (one bond material "
+            "per world)");
+  }
+  auto& p = s.p;
+  require(p.n > 0, "install_bonds: the world has no particles");
+  if (tolerance < 0) {
+    double mean = 0;
+    for (std::size_t i = 0; i < p.n; ++i) mean += p.radius[i];
+    tolerance = 1e-3 * mean / double(p.n);
+  }
+  std::vector<std::uint8_t> chosen(p.n, ids.empty() ? 1 : 0);
+  for (auto id : ids) chosen[index_of(s, id)] = 1;
+  // Candidates come from the neighbour list; make sure it is current and reaches the tolerance.
+  if (s.skin <= 0 || s.skin < tolerance) s.skin = std::max(s.skin, 2 * tolerance);
+  detail::build_neighbors(s);
+  const auto& q = s.pairs;
+  std::vector<std::size_t> picked;
+  for (std::size_t k = 0; k < q.n; ++k) {
+    const auto a = q.a[k], b = q.b[k];
+    if (!chosen[a] || !chosen[b]) continue;
+    const double dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];
+    const double gap = std::sqrt(dx * dx + dy * dy + dz * dz) - p.radius[a] - p.radius[b];
+    if (gap <= tolerance) picked.push_back(k);
+  }
+  // Merge the new bonds into the sorted bond list (pairs are sorted by (a, b), so is `picked`).
+  detail::BondStore merged;
+  merged.material = material;
+  merged.any = true;
+  merged.resize(s.bonds.n + picked.size());
+  std::size_t i = 0, j = 0, k = 0;
+  const auto& old = s.bonds;
+  while (i < old.n || j < picked.size()) {
+    const bool take_old = j == picked.size() ||
+                          (i < old.n && (old.a[i] < q.a[picked[j]] ||
+                                         (old.a[i] == q.a[picked[j]] && old.b[i] < q.b[picked[j]])));
+    if (take_old) {
+      merged.copy_from(old, i++, k++);
+      continue;
+    }
+    const std::size_t c = picked[j++];
+    const auto a = q.a[c], b = q.b[c];
+    const double dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];
+    const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
+    merged.a[k] = a;
+    merged.b[k] = b;
+    merged.beam_radius[k] = material.radius_factor * std::min(p.radius[a], p.radius[b]);  // [3-26]
+    merged.nx[k] = dx / d; merged.ny[k] = dy / d; merged.nz[k] = dz / d;
+    // An existing contact's shear force is kept by the contact bond; the beam starts unloaded.
+    merged.fsx[k] = q.fsx[c]; merged.fsy[k] = q.fsy[c]; merged.fsz[k] = q.fsz[c];
+    merged.overlap[k] = p.radius[a] + p.radius[b] - d;
+    merged.fn[k] = s.settings.contact.kn * merged.overlap[k];
+    merged.fbn[k] = merged.fbsx[k] = merged.fbsy[k] = merged.fbsz[k] = 0;
+    merged.mbn[k] = merged.mbsx[k] = merged.mbsy[k] = merged.mbsz[k] = merged.broken[k] = 0;
+    ++k;
+  }
+  s.bonds = std::move(merged);
+  detail::refresh_bond_topology(s);
+  touch(s);  // bonded pairs leave the contact list
+  return picked.size();
+}
+
+std::size_t World::bond_count() const { return state_->bonds.n; }
+
+double World::bond_criterion(double sigma, double tau, double tensile_strength) {
+  return kernels::elliptic_criterion(sigma, tau, tensile_strength);
+}
+
+std::vector<BondInfo> World::bonds() const {
+  const State& s = *state_;
+  const auto& p = s.p;
+  const auto& q = s.bonds;
+  std::vector<BondInfo> out;
+  out.reserve(q.n);
+  for (std::size_t k = 0; k < q.n; ++k) {
+    BondInfo b;
+    const auto ia = q.a[k], ib = q.b[k];
+    b.id_a = p.id[ia];
+    b.id_b = p.id[ib];
+    b.normal = {q.nx[k], q.ny[k], q.nz[k]};
+    b.point = Vec3{p.x[ia], p.y[ia], p.z[ia]} + b.normal * (p.radius[ia] - 0.5 * q.overlap[k]);
+    b.gap = -q.overlap[k];
+    b.beam_radius = q.beam_radius[k];
+    b.normal_force = q.fn[k] + q.fbn[k];
+    b.shear_force = {q.fsx[k] + q.fbsx[k], q.fsy[k] + q.fbsy[k], q.fsz[k] + q.fbsz[k]};
+    b.twisting_moment = q.mbn[k];
+    b.bending_moment = {q.mbsx[k], q.mbsy[k], q.mbsz[k]};
+    const double rb = q.beam_radius[k], A = kernels::kPi * rb * rb;
+    const Vec3 fbs{q.fbsx[k], q.fbsy[k], q.fbsz[k]};
+    b.sigma = -q.fbn[k] / A + norm(b.bending_moment) * 4.0 / (A * rb);  // [3-27]
+    b.tau = norm(fbs) / A + std::fabs(q.mbn[k]) * 2.0 / (A * rb);
+    if (b.id_a > b.id_b) {
+      std::swap(b.id_a, b.id_b);
+      b.normal = -b.normal;
+      b.shear_force = -b.shear_force;
+      b.twisting_moment = -b.twisting_moment;
+      b.bending_moment = -b.bending_moment;
+    }
+    out.push_back(b);
+  }
+  std::sort(out.begin(), out.end(), [](const BondInfo& u, const BondInfo& v) {
+    return u.id_a != v.id_a ? u.id_a < v.id_a : u.id_b < v.id_b;
+  });
+  return out;
+}
+
+const std::vector<BreakEvent>& World::break_events() const { return state_->break_events; }
 
 // --- running -------------------------------------------------------------------------------
 

@@ -32,12 +32,14 @@ void gather_and_integrate(State& s) {
   const PairStore& q = s.pairs;
   const Incidence& inc = s.incidence;
   const WallContacts& wc = s.walls.contacts;
+  const BondStore& bq = s.bonds;
+  const Incidence& binc = s.bond_incidence;
   const std::size_t n = p.n;
   const std::size_t blocks = (n + kParticleBlock - 1) / kParticleBlock;
   s.particle_blocks.assign(blocks, {});
   const double dt = s.dt, alpha = s.settings.local_damping;
   const Vec3 g = s.settings.gravity;
-  const bool rotation = s.settings.rotation, applied = p.has_applied;
+  const bool rotation = s.any_rotating, applied = p.has_applied;
 
 #pragma omp parallel for schedule(static) num_threads(thread_count(s))
   for (std::size_t blk = 0; blk < blocks; ++blk) {
@@ -58,6 +60,21 @@ void gather_and_integrate(State& s) {
         tx -= lever * (ny * sz - nz * sy);
         ty -= lever * (nz * sx - nx * sz);
         tz -= lever * (nx * sy - ny * sx);
+      }
+      for (std::int32_t e = binc.start[i]; e < binc.start[i + 1]; ++e) {
+        // Bond: contact bond + parallel bond forces, plus the beam's moments on b (-M on a).
+        const std::int64_t k = binc.entry[e] >> 1;
+        const double sgn = (binc.entry[e] & 1) ? 1.0 : -1.0;
+        const double nx = bq.nx[k], ny = bq.ny[k], nz = bq.nz[k];
+        const double sx = bq.fsx[k] + bq.fbsx[k], sy = bq.fsy[k] + bq.fbsy[k], sz = bq.fsz[k] + bq.fbsz[k];
+        const double fn = bq.fn[k] + bq.fbn[k];
+        fx += sgn * (fn * nx + sx);
+        fy += sgn * (fn * ny + sy);
+        fz += sgn * (fn * nz + sz);
+        const double lever = R - 0.5 * bq.overlap[k];
+        tx += sgn * (bq.mbn[k] * nx + bq.mbsx[k]) - lever * (ny * sz - nz * sy);
+        ty += sgn * (bq.mbn[k] * ny + bq.mbsy[k]) - lever * (nz * sx - nx * sz);
+        tz += sgn * (bq.mbn[k] * nz + bq.mbsz[k]) - lever * (nx * sy - ny * sx);
       }
       for (std::int32_t k = wc.start[i]; k < wc.start[i + 1]; ++k) {
         const double nx = wc.nx[k], ny = wc.ny[k], nz = wc.nz[k];

@@ -1,5 +1,6 @@
 // Scalar reference of the pair kernel: one pair at a time, plain doubles. It is the definition
 // the SIMD kernels are tested against, and what a build without SIMD runs.
+#include "kernels/bond_loop.hpp"
 #include "kernels/pair_loop.hpp"
 
 namespace asperity::kernels {
@@ -21,11 +22,17 @@ double pair_rot(const PairKernelArgs& k, std::size_t b, std::size_t e) {
 double pair_norot(const PairKernelArgs& k, std::size_t b, std::size_t e) {
   return pair_loop<ScalarLanes, false>(k, b, e);
 }
+double bond_rot(const BondKernelArgs& k, std::size_t b, std::size_t e) {
+  return bond_loop<ScalarLanes, true>(k, b, e);
+}
+double bond_norot(const BondKernelArgs& k, std::size_t b, std::size_t e) {
+  return bond_loop<ScalarLanes, false>(k, b, e);
+}
 
 }  // namespace
 
 const KernelSet& scalar_kernels() {
-  static const KernelSet set{"scalar", 1, &pair_rot, &pair_norot};
+  static const KernelSet set{"scalar", 1, &pair_rot, &pair_norot, &bond_rot, &bond_norot};
   return set;
 }
 

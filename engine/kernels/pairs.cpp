@@ -15,7 +15,7 @@ kernels::PairKernelArgs pair_kernel_args(State& s) {
 
 void compute_pair_forces(State& s) {
   const auto args = pair_kernel_args(s);
-  const auto kernel = s.settings.rotation ? s.kernels->pair : s.kernels->pair_norot;
+  const auto kernel = s.any_rotating ? s.kernels->pair : s.kernels->pair_norot;
   const std::size_t total = s.pairs.padded;
   const std::size_t blocks = (total + kPairBlock - 1) / kPairBlock;
   s.pair_block_slip.assign(blocks, 0.0);

@@ -4,6 +4,7 @@
 // stores of the pair columns (blocks start at multiples of kMaxLanes on 64-byte aligned columns).
 #include <xsimd/xsimd.hpp>
 
+#include "kernels/bond_loop.hpp"
 #include "kernels/pair_loop.hpp"
 
 #define ASPERITY_CAT2(a, b) a##b
@@ -31,6 +32,12 @@ double pair_rot(const PairKernelArgs& k, std::size_t b, std::size_t e) {
 double pair_norot(const PairKernelArgs& k, std::size_t b, std::size_t e) {
   return pair_loop<SimdLanes, false>(k, b, e);
 }
+double bond_rot(const BondKernelArgs& k, std::size_t b, std::size_t e) {
+  return bond_loop<SimdLanes, true>(k, b, e);
+}
+double bond_norot(const BondKernelArgs& k, std::size_t b, std::size_t e) {
+  return bond_loop<SimdLanes, false>(k, b, e);
+}
 
 }  // namespace
 
@@ -39,7 +46,7 @@ double pair_norot(const PairKernelArgs& k, std::size_t b, std::size_t e) {
 
 const KernelSet& ASPERITY_CAT(kernels_, ASPERITY_SIMD_ARCH)() {
   static const KernelSet set{ASPERITY_STR(ASPERITY_SIMD_ARCH), SimdLanes::size, &pair_rot,
-                             &pair_norot};
+                             &pair_norot, &bond_rot, &bond_norot};
   return set;
 }
 

@@ -165,7 +165,7 @@ void compute_wall_forces(State& s) {
   std::vector<double> slip(blocks, 0.0), work(blocks, 0.0);
   std::vector<Vec3> force(blocks * nw);
   const double dt = s.dt;
-  const bool rot = s.settings.rotation;
+  const bool rot = s.any_rotating;
 #pragma omp parallel for schedule(static) num_threads(thread_count(s))
   for (std::size_t blk = 0; blk < blocks; ++blk) {
     const std::size_t end = std::min(wc.n, (blk + 1) * kParticleBlock);

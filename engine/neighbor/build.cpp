@@ -159,11 +159,61 @@ void reorder(State& s, const CellGrid& g) {
   }
   w = std::move(ws);
 
+  // Bonds: the same renumbering; the history flips with the roles.
+  BondStore& bq = s.bonds;
+  for (std::size_t k = 0; k < bq.n; ++k) {
+    std::int64_t a = new_index[bq.a[k]], b = new_index[bq.b[k]];
+    if (a > b) {
+      std::swap(a, b);
+      for (auto* c : {&bq.nx, &bq.ny, &bq.nz, &bq.fsx, &bq.fsy, &bq.fsz, &bq.fbsx, &bq.fbsy,
+                      &bq.fbsz, &bq.mbn, &bq.mbsx, &bq.mbsy, &bq.mbsz})
+        (*c)[k] = -(*c)[k];
+    }
+    bq.a[k] = a;
+    bq.b[k] = b;
+  }
+  std::vector<std::size_t> bp(bq.n);
+  std::iota(bp.begin(), bp.end(), 0);
+  std::sort(bp.begin(), bp.end(), [&](std::size_t u, std::size_t v) {
+    return bq.a[u] != bq.a[v] ? bq.a[u] < bq.a[v] : bq.b[u] < bq.b[v];
+  });
+  BondStore bs;
+  bs.material = bq.material;
+  bs.any = bq.any;
+  bs.resize(bq.n);
+  for (std::size_t k = 0; k < bq.n; ++k) bs.copy_from(bq, bp[k], k);
+  bq = std::move(bs);
+  // Inherited contacts of broken bonds: renumber (sorted when merged).
+  PairStore& ih = s.inherited;
+  for (std::size_t k = 0; k < ih.n; ++k) {
+    std::int64_t a = new_index[ih.a[k]], b = new_index[ih.b[k]];
+    if (a > b) {
+      std::swap(a, b);
+      ih.nx[k] = -ih.nx[k]; ih.ny[k] = -ih.ny[k]; ih.nz[k] = -ih.nz[k];
+      ih.fsx[k] = -ih.fsx[k]; ih.fsy[k] = -ih.fsy[k]; ih.fsz[k] = -ih.fsz[k];
+    }
+    ih.a[k] = a;
+    ih.b[k] = b;
+  }
   for (auto& grp : s.groups) {
     for (auto& m : grp.members) m = std::int32_t(new_index[m]);
     std::sort(grp.members.begin(), grp.members.end());
   }
+  s.user_rotation_locked.resize(p.n, 0);
+  {
+    std::vector<std::uint8_t> ul(p.n);
+    for (std::size_t i = 0; i < p.n; ++i) ul[i] = s.user_rotation_locked[order[i]];
+    s.user_rotation_locked.swap(ul);
+  }
+  refresh_bond_topology(s);
   ++s.reorders;
+}
+
+inline bool bonded(const State& s, std::size_t i, std::int32_t o) {
+  if (s.partners.empty()) return false;
+  const auto first = s.partners.begin() + s.partner_start[i];
+  const auto last = s.partners.begin() + s.partner_start[i + 1];
+  return first != last && std::binary_search(first, last, o);
 }
 
 // The j > i within reach of particle i, ascending.
@@ -182,6 +232,7 @@ void neighbours_of(const State& s, const CellGrid& g, std::size_t i, Out&& out) 
           const std::int32_t o = g.members[t];
           if (std::size_t(o) <= i) continue;
           if (gi >= 0 && p.group[o] == gi) continue;
+          if (bonded(s, i, o)) continue;
           const double dx = p.x[o] - p.x[i], dy = p.y[o] - p.y[i], dz = p.z[o] - p.z[i];
           const double cut = reach + p.radius[o];
           if (dx * dx + dy * dy + dz * dz < cut * cut) out(o);
@@ -234,26 +285,31 @@ void build_pairs(State& s, const CellGrid& g) {
       fresh.overlap[k] = p.radius[a] + p.radius[b] - d;
     }
   }
+  // Contacts left behind by broken bonds take over their capped shear force.
+  PairStore& ih = s.inherited;
+  if (ih.n > 0) {
+    std::vector<std::size_t> order(ih.n);
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](std::size_t u, std::size_t v) {
+      return ih.a[u] != ih.a[v] ? ih.a[u] < ih.a[v] : ih.b[u] < ih.b[v];
+    });
+    std::size_t j = 0;
+    for (std::size_t k = 0; k < total && j < ih.n; ++k) {
+      while (j < ih.n && (ih.a[order[j]] < fresh.a[k] ||
+                          (ih.a[order[j]] == fresh.a[k] && ih.b[order[j]] < fresh.b[k])))
+        ++j;
+      if (j < ih.n && ih.a[order[j]] == fresh.a[k] && ih.b[order[j]] == fresh.b[k]) {
+        const std::size_t o = order[j];
+        fresh.nx[k] = ih.nx[o]; fresh.ny[k] = ih.ny[o]; fresh.nz[k] = ih.nz[o];
+        fresh.fsx[k] = ih.fsx[o]; fresh.fsy[k] = ih.fsy[o]; fresh.fsz[k] = ih.fsz[o];
+        fresh.fn[k] = ih.fn[o]; fresh.overlap[k] = ih.overlap[o];
+      }
+    }
+    ih.resize(0);
+  }
   fresh.fill_padding(p.null_a(), p.null_b());
   s.pairs = std::move(fresh);
-
-  // Incidence: for particle q, the pairs where it is b (all with a < q, so they come earlier in
-  // the list) and then those where it is a: ascending pair order.
-  Incidence& inc = s.incidence;
-  inc.start.assign(n + 1, 0);
-  for (std::size_t k = 0; k < total; ++k) {
-    ++inc.start[s.pairs.a[k] + 1];
-    ++inc.start[s.pairs.b[k] + 1];
-  }
-  std::partial_sum(inc.start.begin(), inc.start.end(), inc.start.begin());
-  inc.entry.resize(2 * total);
-  std::vector<std::int32_t> fill(inc.start.begin(), inc.start.end() - 1);
-  for (std::size_t k = 0; k < total; ++k) {
-    inc.entry[fill[s.pairs.b[k]]++] = std::int64_t(k) << 1 | 1;
-  }
-  for (std::size_t k = 0; k < total; ++k) inc.entry[fill[s.pairs.a[k]]++] = std::int64_t(k) << 1;
-  // Particles as b were filled first, then as a; each run is ascending and every b-pair of q
-  // precedes its a-pairs, so each particle's entries are in ascending pair order.
+  build_incidence(n, s.pairs.a.data(), s.pairs.b.data(), total, s.incidence);
 }
 
 void build_wall_contacts(State& s) {

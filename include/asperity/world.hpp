@@ -31,6 +31,17 @@ struct ContactMaterial {
   double friction = 0.5;   // Coulomb coefficient mu
 };
 
+// Contact bond + parallel bond installed together (model.md 5). The beam of radius
+// Rb = radius_factor * min(Ra, Rb) acts as springs of stiffness kbn A = beam_kn and kbs A = beam_ks
+// (defaults: as stiff as the contact springs, kbs = kbn / 10).
+struct BondMaterial {
+  double beam_kn = 0.1;            // kbn * A, N/m
+  double beam_ks = 0.01;           // kbs * A, N/m
+  double radius_factor = 1.0;      // lambda
+  double tensile_strength = 0.0;   // st, Pa (elliptic criterion [3-46..3-49])
+  bool breakable = true;           // false: the elastic model (bonds never break)
+};
+
 struct WorldSettings {
   ContactMaterial contact;          // ball-ball contacts
   double density = 2500.0;          // kg/m^3, default for add_particle
@@ -46,6 +57,7 @@ struct WorldSettings {
   std::string simd = "auto";        // "auto", "scalar", "sse4_2", "avx2", "avx512f"
   bool track_energy = true;         // friction, damping and boundary work ledgers (model.md 8)
   int reorder_interval = 10;        // neighbour rebuilds between space-filling-curve reorders; 0: never
+  bool lock_bonded_rotation = true; // a particle holding an intact bond does not rotate (model.md 2)
 };
 
 // How a rigid group's degree of freedom moves (model.md 1).
@@ -67,14 +79,40 @@ struct ContactInfo {  // one ball-ball contact (touching pair), for inspection a
   Vec3 shear_force;    // Fs on b
 };
 
+struct BondInfo {  // one intact bond, for inspection and output
+  std::int64_t id_a, id_b;    // id_a < id_b; forces act on b, their negatives on a
+  Vec3 normal;                // unit, from a to b
+  Vec3 point;                 // contact point
+  double gap;                 // -U: > 0 when stretched
+  double beam_radius;         // Rb
+  double normal_force;        // contact bond + parallel bond, > 0 in compression
+  Vec3 shear_force;           // contact bond + parallel bond
+  double twisting_moment;     // Mbn (along the normal)
+  Vec3 bending_moment;        // Mbs
+  double sigma, tau;          // periphery stresses [3-27], tension positive, Pa
+};
+
+struct BreakEvent {  // model.md 5: every break
+  std::uint64_t step;
+  double time;
+  Vec3 position;              // contact point
+  std::int64_t id_a, id_b;
+  // Which stress was nearest its own failure value (st in tension, 10 st in compression, 5 st
+  // in shear).
+  enum class Mode : std::uint8_t { tension, compression, shear } mode;
+  double sigma, tau;          // at the break
+  double released_energy;     // strain energy of the bond that was not kept by a contact, J
+};
+
 struct Energies {            // model.md 8; all in J
   double kinetic = 0;        // translational + rotational
-  double strain = 0;         // stored in the contact springs
+  double strain = 0;         // stored in the contact springs and bonds
   double friction = 0;       // dissipated by Coulomb slip (cumulative)
   double damping = 0;        // dissipated by local damping (cumulative)
   double boundary_work = 0;  // done on the particles by walls, velocity-prescribed groups and
                              // applied external forces (cumulative)
   double gravity_work = 0;   // done by gravity (cumulative)
+  double released = 0;       // strain energy released by bond breaks (cumulative)
   // Input work minus what is stored and dissipated (zero for a perfect balance).
   double balance_error(const Energies& initial) const;
 };
@@ -159,6 +197,19 @@ class World {
   double group_mass(int group) const;
   std::vector<std::int64_t> group_members(int group) const;
   std::size_t group_count() const;
+
+  // --- bonds (model.md 5) ----------------------------------------------------------------
+  // Bond every pair whose gap d - Ra - Rb <= tolerance (tolerance < 0: 1e-3 x mean radius), at
+  // the current configuration; existing contact forces are kept. With `ids`, only pairs of two
+  // listed particles. Pairs already bonded and members of one rigid group are skipped.
+  // Returns the number of bonds installed.
+  std::size_t install_bonds(const BondMaterial& material, double tolerance = -1,
+                            std::span<const std::int64_t> ids = {});
+  std::size_t bond_count() const;                   // intact bonds
+  std::vector<BondInfo> bonds() const;
+  const std::vector<BreakEvent>& break_events() const;
+  // Sigma and tau [3-27] of every intact bond, and the elliptic criterion's value (>= 1: fails).
+  static double bond_criterion(double sigma, double tau, double tensile_strength);
 
   // --- running ---------------------------------------------------------------------------
   // Advance n steps. Returns the number of steps done: fewer than n only if request_stop() was

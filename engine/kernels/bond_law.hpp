@@ -1,0 +1,95 @@
+// The bond law of model.md section 5 [3-23..3-27, 3-46..3-49], as a template on the number type
+// (double for the scalar reference, xsimd batches for the SIMD kernels), like contact_law.hpp.
+//
+// While intact, a bond is a contact bond (the contact springs of section 4 acting in tension
+// too, shear without slip) plus a parallel bond (an elastic beam of radius Rb whose force and
+// moments grow incrementally from zero). With kbn A = beam_kn and kbs A = beam_ks:
+//   dFbn = beam_kn (-(V.n)) dt                  dFbs = -beam_ks Vs dt
+//   dMbn = -kbs J (wrel.n) dt = -beam_ks Rb^2/2 (wrel.n) dt
+//   dMbs = -kbn I wrel_s dt   = -beam_kn Rb^2/4 wrel_s dt
+// (J / A = Rb^2 / 2, I / A = Rb^2 / 4 [3-26]). Periphery stresses [3-27], tension positive:
+//   sigma = -Fbn / A + |Mbs| Rb / I,   tau = |Fbs| / A + |Mbn| Rb / J.
+// Elliptic criterion: ((sigma - h) / a)^2 + (tau / b)^2 >= 1, a = 5.5 st, h = -4.5 st,
+// b = 5 st a / sqrt(a^2 - h^2): fails at sigma = st, sigma = -10 st, tau = 5 st.
+#pragma once
+#include "kernels/contact_law.hpp"
+
+namespace asperity::kernels {
+
+inline constexpr double kPi = 3.14159265358979323846;
+
+template <class T>
+struct BondParams {
+  T kn, ks, beam_kn, beam_ks, dt;
+  T strength;   // st; 0 or less: unbreakable
+};
+
+// Criterion value ((sigma - h) / a)^2 + (tau / b)^2 for strength st (>= 1: the bond fails).
+template <class T>
+inline T elliptic_criterion(const T& sigma, const T& tau, const T& st) {
+  const T a = 5.5 * st, h = -4.5 * st;
+  const T b = 5.0 * st * a / sqrt(a * a - h * h);
+  const T u = (sigma - h) / a, v = tau / b;
+  return u * u + v * v;
+}
+
+// Everything one bond needs; in/out fields hold the history on entry and the new state on exit.
+template <class T>
+struct BondState {
+  T fsx, fsy, fsz;        // contact bond shear
+  T fn;                   // contact bond normal force (out)
+  T fbn, fbsx, fbsy, fbsz;
+  T mbn, mbsx, mbsy, mbsz;
+};
+
+// Returns the criterion value (>= 1: broken); sigma and tau are returned too.
+template <class T>
+inline T bond_forces(const T& nx, const T& ny, const T& nz, const T& U, const T& la, const T& lb,
+                     const T& rb, const T& vax, const T& vay, const T& vaz, const T& wax,
+                     const T& way, const T& waz, const T& vbx, const T& vby, const T& vbz,
+                     const T& wbx, const T& wby, const T& wbz, const T& ox, const T& oy,
+                     const T& oz, BondState<T>& s, T& sigma, T& tau, const BondParams<T>& p) {
+  // Relative velocity at the contact point [3-17, 3-18], as in contact_forces.
+  const T vx = (vbx - vax) - lb * (wby * nz - wbz * ny) - la * (way * nz - waz * ny);
+  const T vy = (vby - vay) - lb * (wbz * nx - wbx * nz) - la * (waz * nx - wax * nz);
+  const T vz = (vbz - vaz) - lb * (wbx * ny - wby * nx) - la * (wax * ny - way * nx);
+  const T vn = vx * nx + vy * ny + vz * nz;
+  const T vsx = vx - vn * nx, vsy = vy - vn * ny, vsz = vz - vn * nz;
+  const T phi = 0.5 * p.dt * ((wax + wbx) * nx + (way + wby) * ny + (waz + wbz) * nz);
+  // Shear force, beam shear force and bending moment are carried with the contact plane.
+  carry_shear(ox, oy, oz, nx, ny, nz, phi, s.fsx, s.fsy, s.fsz);
+  carry_shear(ox, oy, oz, nx, ny, nz, phi, s.fbsx, s.fbsy, s.fbsz);
+  carry_shear(ox, oy, oz, nx, ny, nz, phi, s.mbsx, s.mbsy, s.mbsz);
+
+  // Contact bond: springs in tension too, no slip.
+  s.fn = p.kn * U;
+  s.fsx = s.fsx - p.ks * vsx * p.dt;
+  s.fsy = s.fsy - p.ks * vsy * p.dt;
+  s.fsz = s.fsz - p.ks * vsz * p.dt;
+
+  // Parallel bond increments.
+  const T rx = wbx - wax, ry = wby - way, rz = wbz - waz;
+  const T rn = rx * nx + ry * ny + rz * nz;
+  const T rsx = rx - rn * nx, rsy = ry - rn * ny, rsz = rz - rn * nz;
+  const T r2 = rb * rb;
+  s.fbn = s.fbn - p.beam_kn * vn * p.dt;
+  s.fbsx = s.fbsx - p.beam_ks * vsx * p.dt;
+  s.fbsy = s.fbsy - p.beam_ks * vsy * p.dt;
+  s.fbsz = s.fbsz - p.beam_ks * vsz * p.dt;
+  s.mbn = s.mbn - p.beam_ks * (0.5 * r2) * rn * p.dt;
+  const T kbend = p.beam_kn * (0.25 * r2);
+  s.mbsx = s.mbsx - kbend * rsx * p.dt;
+  s.mbsy = s.mbsy - kbend * rsy * p.dt;
+  s.mbsz = s.mbsz - kbend * rsz * p.dt;
+
+  // Periphery stresses [3-27] with A = pi Rb^2, I = pi Rb^4 / 4, J = pi Rb^4 / 2.
+  const T A = kPi * r2;
+  const T fbs = sqrt(s.fbsx * s.fbsx + s.fbsy * s.fbsy + s.fbsz * s.fbsz);
+  const T mbs = sqrt(s.mbsx * s.mbsx + s.mbsy * s.mbsy + s.mbsz * s.mbsz);
+  const T mbn = select(s.mbn < T(0.0), -s.mbn, s.mbn);
+  sigma = -s.fbn / A + mbs * 4.0 / (A * rb);
+  tau = fbs / A + mbn * 2.0 / (A * rb);
+  return elliptic_criterion(sigma, tau, p.strength);
+}
+
+}  // namespace asperity::kernels

@@ -1,0 +1,59 @@
+// The bond loop shared by the scalar reference and the SIMD kernels (see pair_loop.hpp).
+#pragma once
+#include "kernels/bond_law.hpp"
+#include "kernels/kernels.hpp"
+
+namespace asperity::kernels {
+
+template <class Lanes, bool Rotation>
+double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
+  using T = typename Lanes::Real;
+  const BondParams<T> p{T(k.kn), T(k.ks), T(k.beam_kn), T(k.beam_ks), T(k.dt), T(k.strength)};
+  const bool breakable = k.strength > 0;
+  T count(0.0);
+  for (std::size_t i = begin; i < end; i += Lanes::size) {
+    const auto ia = Lanes::index(k.a + i);
+    const auto ib = Lanes::index(k.b + i);
+    const T xa = Lanes::gather(k.x, ia), ya = Lanes::gather(k.y, ia), za = Lanes::gather(k.z, ia);
+    const T xb = Lanes::gather(k.x, ib), yb = Lanes::gather(k.y, ib), zb = Lanes::gather(k.z, ib);
+    const T ra = Lanes::gather(k.radius, ia), rb = Lanes::gather(k.radius, ib);
+    T nx, ny, nz, U, la, lb;
+    ball_ball_geometry(xa, ya, za, xb, yb, zb, ra, rb, nx, ny, nz, U, la, lb);
+    const T vax = Lanes::gather(k.vx, ia), vay = Lanes::gather(k.vy, ia), vaz = Lanes::gather(k.vz, ia);
+    const T vbx = Lanes::gather(k.vx, ib), vby = Lanes::gather(k.vy, ib), vbz = Lanes::gather(k.vz, ib);
+    T wax(0.0), way(0.0), waz(0.0), wbx(0.0), wby(0.0), wbz(0.0);
+    if constexpr (Rotation) {
+      wax = Lanes::gather(k.wx, ia); way = Lanes::gather(k.wy, ia); waz = Lanes::gather(k.wz, ia);
+      wbx = Lanes::gather(k.wx, ib); wby = Lanes::gather(k.wy, ib); wbz = Lanes::gather(k.wz, ib);
+    }
+    const T ox = Lanes::load(k.nx + i), oy = Lanes::load(k.ny + i), oz = Lanes::load(k.nz + i);
+    BondState<T> s{Lanes::load(k.fsx + i), Lanes::load(k.fsy + i), Lanes::load(k.fsz + i), T(0.0),
+                   Lanes::load(k.fbn + i), Lanes::load(k.fbsx + i), Lanes::load(k.fbsy + i),
+                   Lanes::load(k.fbsz + i), Lanes::load(k.mbn + i), Lanes::load(k.mbsx + i),
+                   Lanes::load(k.mbsy + i), Lanes::load(k.mbsz + i)};
+    const T rbeam = Lanes::load(k.beam_radius + i);
+    // Padding bonds have Rb = 0; give them a harmless radius so no lane divides by zero.
+    const auto real = rbeam > T(0.0);
+    const T rsafe = select(real, rbeam, T(1.0));
+    T sigma, tau;
+    const T crit = bond_forces(nx, ny, nz, U, la, lb, rsafe, vax, vay, vaz, wax, way, waz, vbx, vby,
+                               vbz, wbx, wby, wbz, ox, oy, oz, s, sigma, tau, p);
+    T brk(0.0);
+    if (breakable) {
+      brk = select(real & (crit >= T(1.0)), T(1.0), T(0.0));
+      count = count + brk;
+    }
+    Lanes::store(k.nx + i, nx); Lanes::store(k.ny + i, ny); Lanes::store(k.nz + i, nz);
+    Lanes::store(k.fsx + i, s.fsx); Lanes::store(k.fsy + i, s.fsy); Lanes::store(k.fsz + i, s.fsz);
+    Lanes::store(k.fn + i, select(real, s.fn, T(0.0)));
+    Lanes::store(k.overlap + i, U);
+    Lanes::store(k.fbn + i, s.fbn);
+    Lanes::store(k.fbsx + i, s.fbsx); Lanes::store(k.fbsy + i, s.fbsy); Lanes::store(k.fbsz + i, s.fbsz);
+    Lanes::store(k.mbn + i, s.mbn);
+    Lanes::store(k.mbsx + i, s.mbsx); Lanes::store(k.mbsy + i, s.mbsy); Lanes::store(k.mbsz + i, s.mbsz);
+    Lanes::store(k.broken + i, brk);
+  }
+  return Lanes::sum(count);
+}
+
+}  // namespace asperity::kernels

@@ -1,0 +1,191 @@
+// Stage `bonds` (model.md 5): the bond kernel over fixed blocks of the bond list, then, in
+// bookkeeping, the breaks: an event each, the released strain energy, the contact a broken bond
+// leaves behind, compaction of the list and the rotation locks.
+#include <algorithm>
+#include <cmath>
+
+#include "kernels/bond_law.hpp"
+#include "state.hpp"
+
+namespace asperity::detail {
+
+namespace {
+kernels::BondKernelArgs bond_kernel_args(State& s) {
+  ParticleStore& p = s.p;
+  BondStore& q = s.bonds;
+  const ContactMaterial& m = s.settings.contact;
+  const BondMaterial& bm = q.material;
+  return {p.x.data(), p.y.data(), p.z.data(), p.vx.data(), p.vy.data(), p.vz.data(),
+          p.wx.data(), p.wy.data(), p.wz.data(), p.radius.data(), q.a.data(), q.b.data(),
+          q.beam_radius.data(), q.nx.data(), q.ny.data(), q.nz.data(), q.fsx.data(),
+          q.fsy.data(), q.fsz.data(), q.fn.data(), q.overlap.data(), q.fbn.data(), q.fbsx.data(),
+          q.fbsy.data(), q.fbsz.data(), q.mbn.data(), q.mbsx.data(), q.mbsy.data(),
+          q.mbsz.data(), q.broken.data(), m.kn, m.ks, bm.beam_kn, bm.beam_ks, s.dt,
+          bm.breakable ? bm.tensile_strength : 0.0};
+}
+
+struct BondEnergy {
+  double total, contact_kept, capped_fs_scale;
+};
+
+// Strain energy of bond k (model.md 8) and what an ordinary contact keeps of it after a break.
+BondEnergy bond_energy(const State& s, std::size_t k) {
+  const BondStore& q = s.bonds;
+  const ContactMaterial& m = s.settings.contact;
+  const BondMaterial& bm = q.material;
+  const double r2 = q.beam_radius[k] * q.beam_radius[k];
+  const double fs2 = q.fsx[k] * q.fsx[k] + q.fsy[k] * q.fsy[k] + q.fsz[k] * q.fsz[k];
+  const double fbs2 = q.fbsx[k] * q.fbsx[k] + q.fbsy[k] * q.fbsy[k] + q.fbsz[k] * q.fbsz[k];
+  const double mbs2 = q.mbsx[k] * q.mbsx[k] + q.mbsy[k] * q.mbsy[k] + q.mbsz[k] * q.mbsz[k];
+  BondEnergy e;
+  e.total = q.fn[k] * q.fn[k] / (2 * m.kn) + fs2 / (2 * m.ks) + q.fbn[k] * q.fbn[k] / (2 * bm.beam_kn) +
+            fbs2 / (2 * bm.beam_ks) + q.mbn[k] * q.mbn[k] / (2 * bm.beam_ks * 0.5 * r2) +
+            mbs2 / (2 * bm.beam_kn * 0.25 * r2);
+  e.contact_kept = 0;
+  e.capped_fs_scale = 0;
+  if (q.overlap[k] > 0) {  // stays a contact: Fn = kn U, Fs capped at mu Fn
+    const double fn = q.fn[k], limit = m.friction * fn, fs = std::sqrt(fs2);
+    e.capped_fs_scale = fs > limit ? limit / fs : 1.0;
+    e.contact_kept = fn * fn / (2 * m.kn) + fs2 * e.capped_fs_scale * e.capped_fs_scale / (2 * m.ks);
+  }
+  return e;
+}
+}  // namespace
+
+void build_incidence(std::size_t particles, const std::int64_t* a, const std::int64_t* b,
+                     std::size_t count, Incidence& inc) {
+  inc.start.assign(particles + 1, 0);
+  for (std::size_t k = 0; k < count; ++k) {
+    ++inc.start[a[k] + 1];
+    ++inc.start[b[k] + 1];
+  }
+  for (std::size_t i = 0; i < particles; ++i) inc.start[i + 1] += inc.start[i];
+  inc.entry.resize(2 * count);
+  std::vector<std::int32_t> fill(inc.start.begin(), inc.start.end() - 1);
+  // Entries as b first: their a < the particle, so they precede its own a-pairs in the sorted
+  // list; each run is ascending, so every particle's entries are in ascending order.
+  for (std::size_t k = 0; k < count; ++k) inc.entry[fill[b[k]]++] = std::int64_t(k) << 1 | 1;
+  for (std::size_t k = 0; k < count; ++k) inc.entry[fill[a[k]]++] = std::int64_t(k) << 1;
+}
+
+void refresh_bond_topology(State& s) {
+  ParticleStore& p = s.p;
+  BondStore& q = s.bonds;
+  q.fill_padding(p.null_a(), p.null_b());
+  build_incidence(p.n, q.a.data(), q.b.data(), q.n, s.bond_incidence);
+  s.partner_start.assign(p.n + 1, 0);
+  for (std::size_t k = 0; k < q.n; ++k) {
+    ++s.partner_start[q.a[k] + 1];
+    ++s.partner_start[q.b[k] + 1];
+  }
+  for (std::size_t i = 0; i < p.n; ++i) s.partner_start[i + 1] += s.partner_start[i];
+  s.partners.resize(2 * q.n);
+  std::vector<std::int32_t> fill(s.partner_start.begin(), s.partner_start.end() - 1);
+  for (std::size_t k = 0; k < q.n; ++k) {
+    s.partners[fill[q.a[k]]++] = std::int32_t(q.b[k]);
+    s.partners[fill[q.b[k]]++] = std::int32_t(q.a[k]);
+  }
+  for (std::size_t i = 0; i < p.n; ++i)
+    std::sort(s.partners.begin() + s.partner_start[i], s.partners.begin() + s.partner_start[i + 1]);
+  // Rotation locks [thesis 3.3]: a particle holding an intact bond does not rotate.
+  s.user_rotation_locked.resize(p.n, 0);
+  s.any_rotating = false;
+  for (std::size_t i = 0; i < p.n; ++i) {
+    const bool bonded = s.partner_start[i + 1] > s.partner_start[i];
+    const bool locked = !s.settings.rotation || s.user_rotation_locked[i] ||
+                        (s.settings.lock_bonded_rotation && bonded);
+    if (locked && !p.rotation_locked[i]) p.wx[i] = p.wy[i] = p.wz[i] = 0;
+    p.rotation_locked[i] = locked ? 1 : 0;
+    s.any_rotating = s.any_rotating || !locked;
+  }
+}
+
+void compute_bond_forces(State& s) {
+  if (s.bonds.n == 0) return;
+  const auto args = bond_kernel_args(s);
+  const auto kernel = s.any_rotating ? s.kernels->bond : s.kernels->bond_norot;
+  const std::size_t total = s.bonds.padded;
+  const std::size_t blocks = (total + kPairBlock - 1) / kPairBlock;
+  s.bond_block_breaks.assign(blocks, 0.0);
+  double* breaks = s.bond_block_breaks.data();
+#pragma omp parallel for schedule(static) num_threads(thread_count(s))
+  for (std::size_t blk = 0; blk < blocks; ++blk) {
+    const std::size_t begin = blk * kPairBlock;
+    breaks[blk] = kernel(args, begin, std::min(total, begin + kPairBlock));
+  }
+}
+
+void process_breaks(State& s) {
+  BondStore& q = s.bonds;
+  double any = 0;
+  for (double b : s.bond_block_breaks) any += b;
+  s.bond_block_breaks.clear();
+  if (any == 0) return;
+  const ParticleStore& p = s.p;
+  BondStore kept;
+  kept.material = q.material;
+  kept.any = q.any;
+  kept.resize(q.n);
+  std::size_t n = 0;
+  std::vector<std::size_t> inherit;
+  for (std::size_t k = 0; k < q.n; ++k) {
+    if (q.broken[k] == 0) {
+      kept.copy_from(q, k, n++);
+      continue;
+    }
+    const auto a = q.a[k], b = q.b[k];
+    const double rb = q.beam_radius[k], A = kernels::kPi * rb * rb;
+    const double fbs = std::sqrt(q.fbsx[k] * q.fbsx[k] + q.fbsy[k] * q.fbsy[k] + q.fbsz[k] * q.fbsz[k]);
+    const double mbs = std::sqrt(q.mbsx[k] * q.mbsx[k] + q.mbsy[k] * q.mbsy[k] + q.mbsz[k] * q.mbsz[k]);
+    const double sigma = -q.fbn[k] / A + mbs * 4.0 / (A * rb);
+    const double tau = fbs / A + std::fabs(q.mbn[k]) * 2.0 / (A * rb);
+    // Mode: the stress closest (relative to its own failure value: st in tension, 10 st in
+    // compression, 5 st in shear) to failing on its own dominates.
+    const double st = q.material.tensile_strength;
+    const double normal_part = sigma >= 0 ? sigma / st : -sigma / (10 * st);
+    const double shear_part = tau / (5 * st);
+    BreakEvent ev;
+    ev.step = s.step;
+    ev.time = s.time;
+    const Vec3 n{q.nx[k], q.ny[k], q.nz[k]};
+    ev.position = Vec3{p.x[a], p.y[a], p.z[a]} + n * (p.radius[a] - 0.5 * q.overlap[k]);
+    ev.id_a = p.id[a];
+    ev.id_b = p.id[b];
+    ev.mode = shear_part > normal_part ? BreakEvent::Mode::shear
+              : (sigma >= 0 ? BreakEvent::Mode::tension : BreakEvent::Mode::compression);
+    ev.sigma = sigma;
+    ev.tau = tau;
+    const BondEnergy e = bond_energy(s, k);
+    ev.released_energy = e.total - e.contact_kept;
+    if (s.settings.track_energy) s.ledger.released += ev.released_energy;
+    s.break_events.push_back(ev);
+    if (q.overlap[k] > 0) inherit.push_back(k);
+  }
+  // The contacts broken bonds leave behind, sorted by (a, b) like the pair list.
+  PairStore& inh = s.inherited;
+  const std::size_t before = inh.n;
+  PairStore grown;
+  grown.resize(before + inherit.size());
+  for (std::size_t k = 0; k < before; ++k) {
+    grown.a[k] = inh.a[k]; grown.b[k] = inh.b[k];
+    grown.nx[k] = inh.nx[k]; grown.ny[k] = inh.ny[k]; grown.nz[k] = inh.nz[k];
+    grown.fsx[k] = inh.fsx[k]; grown.fsy[k] = inh.fsy[k]; grown.fsz[k] = inh.fsz[k];
+    grown.fn[k] = inh.fn[k]; grown.overlap[k] = inh.overlap[k];
+  }
+  for (std::size_t j = 0; j < inherit.size(); ++j) {
+    const std::size_t k = inherit[j], t = before + j;
+    const double scale = bond_energy(s, k).capped_fs_scale;
+    grown.a[t] = q.a[k]; grown.b[t] = q.b[k];
+    grown.nx[t] = q.nx[k]; grown.ny[t] = q.ny[k]; grown.nz[t] = q.nz[k];
+    grown.fsx[t] = q.fsx[k] * scale; grown.fsy[t] = q.fsy[k] * scale; grown.fsz[t] = q.fsz[k] * scale;
+    grown.fn[t] = q.fn[k]; grown.overlap[t] = q.overlap[k];
+  }
+  inh = std::move(grown);
+  kept.n = n;
+  kept.resize(n);
+  q = std::move(kept);
+  refresh_bond_topology(s);
+  s.need_rebuild = true;  // the freed pairs enter the contact list
+}
+
+}  // namespace asperity::detail

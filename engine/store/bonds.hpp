@@ -1,0 +1,64 @@
+// Bond store (model.md 5): the persistent list of contact + parallel bonds, never rebuilt by the
+// neighbour search. Sorted by (a, b) current index with a < b, like the pair list; padded to the
+// SIMD width with bonds between two null particles (zero beam radius: they never act or break).
+//
+// Per bond, the history the incremental law needs (normal, contact shear force, beam force and
+// moments) and the outputs of the step (contact normal force, overlap, break flag). Forces and
+// moments act on b; their negatives (plus lever-arm torques) on a.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "asperity/world.hpp"
+#include "core/aligned.hpp"
+
+namespace asperity::detail {
+
+struct BondStore {
+  std::size_t n = 0;
+  std::size_t padded = 0;
+  AVec<std::int64_t> a, b;
+  AVec<double> beam_radius;               // Rb
+  AVec<double> nx, ny, nz;                // normal of the last step
+  AVec<double> fsx, fsy, fsz;             // contact bond shear force (history)
+  AVec<double> fn;                        // contact bond normal force kn U (may be < 0)
+  AVec<double> overlap;                   // U
+  AVec<double> fbn;                       // parallel bond normal force (> 0 compression)
+  AVec<double> fbsx, fbsy, fbsz;          // parallel bond shear force
+  AVec<double> mbn;                       // twisting moment (along n)
+  AVec<double> mbsx, mbsy, mbsz;          // bending moment
+  AVec<double> broken;                    // 1 when the criterion was met this step
+  BondMaterial material;
+  bool any = false;                       // a material was set by a first installation
+
+  void resize(std::size_t count) {
+    n = count;
+    padded = round_up(count, kMaxLanes);
+    for (auto* c : {&a, &b}) c->resize(padded);
+    for (auto* c : {&beam_radius, &nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &overlap, &fbn, &fbsx,
+                    &fbsy, &fbsz, &mbn, &mbsx, &mbsy, &mbsz, &broken})
+      c->resize(padded);
+  }
+  void fill_padding(std::int64_t null_a, std::int64_t null_b) {
+    for (std::size_t i = n; i < padded; ++i) {
+      a[i] = null_a;
+      b[i] = null_b;
+      beam_radius[i] = 0;
+      nx[i] = 1;
+      ny[i] = nz[i] = fsx[i] = fsy[i] = fsz[i] = fn[i] = overlap[i] = fbn[i] = 0;
+      fbsx[i] = fbsy[i] = fbsz[i] = mbn[i] = mbsx[i] = mbsy[i] = mbsz[i] = broken[i] = 0;
+    }
+  }
+  // Copy bond o of `from` into slot k of this store.
+  void copy_from(const BondStore& from, std::size_t o, std::size_t k) {
+    a[k] = from.a[o]; b[k] = from.b[o]; beam_radius[k] = from.beam_radius[o];
+    nx[k] = from.nx[o]; ny[k] = from.ny[o]; nz[k] = from.nz[o];
+    fsx[k] = from.fsx[o]; fsy[k] = from.fsy[o]; fsz[k] = from.fsz[o];
+    fn[k] = from.fn[o]; overlap[k] = from.overlap[o]; fbn[k] = from.fbn[o];
+    fbsx[k] = from.fbsx[o]; fbsy[k] = from.fbsy[o]; fbsz[k] = from.fbsz[o];
+    mbn[k] = from.mbn[o]; mbsx[k] = from.mbsx[o]; mbsy[k] = from.mbsy[o]; mbsz[k] = from.mbsz[o];
+    broken[k] = from.broken[o];
+  }
+};
+
+}  // namespace asperity::detail
