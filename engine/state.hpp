@@ -1,6 +1,7 @@
 // Everything a World holds, in one struct the stages share. See engine/step.cpp for the order in
 // which the stages read and write it.
 #pragma once
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <vector>
@@ -15,7 +16,12 @@
 namespace asperity::detail {
 
 struct Group {
-  std::vector<std::int32_t> members;  // current particle indices
+  std::vector<std::int32_t> members;  // current particle indices, moved every step
+  std::vector<std::int32_t> inert;    // members moved only when read (see World::set_inert)
+  Vec3 inert_shift{0, 0, 0};          // group displacement not yet applied to the inert members
+  double inert_mass = 0;
+  Vec3 servo_origin{0, 0, 0};         // centre when the motion was set (CNS reference)
+  double contact_stiffness = 0;       // summed kn of the members' contacts (servo gain)
   GroupMotion motion;
   double mass = 0;
   Vec3 centre, velocity, angular_velocity;
@@ -60,6 +66,7 @@ struct State {
   std::vector<std::uint8_t> user_rotation_locked;  // set by the API; bonds add their own lock
   bool any_rotating = true;  // some particle can rotate: kernels read angular velocities
   const kernels::KernelSet* kernels = nullptr;
+  int max_threads = 1;
 
   double dt = 0;             // in use
   double dt_estimate = 0;    // last critical estimate (no safety factor)
@@ -102,6 +109,8 @@ void advance_groups(State& s);          // bodies/groups.cpp
 double estimate_critical_dt(const State& s);  // step.cpp
 Energies compute_energies(const State& s);    // step.cpp
 void step_once(State& s);               // step.cpp
+void update_servo_stiffness(State& s);  // bodies/groups.cpp
+void sync_inert(State& s);              // bodies/groups.cpp: bring inert members up to date
 
 // Geometry helpers shared by the wall kernel and the neighbour search (kernels/walls.cpp).
 // Closest point on triangle (a, b, c) to p; `feature`: 0 face, 1..3 vertex a, b, c, 4..6 edge ab,
@@ -112,6 +121,12 @@ void bin_mesh(Mesh& mesh);
 // Candidate triangles of `mesh` within `reach` of the point `q` (mesh coordinates), sorted.
 void query_mesh(const Mesh& mesh, const Vec3& q, double reach, std::vector<std::int32_t>& out);
 
-inline int thread_count(const State& s) { return s.settings.threads; }
+// Threads for a parallel stage. Automatic (settings.threads == 0): one per 20 000 particles up
+// to the cores available; below that, thread start-up and barriers cost more than they save
+// (on a loaded machine spinning threads make a small scene many times slower).
+inline int thread_count(const State& s) {
+  if (s.settings.threads > 0) return s.settings.threads;
+  return std::clamp(int(s.p.n / 20000) + 1, 1, s.max_threads);
+}
 
 }  // namespace asperity::detail

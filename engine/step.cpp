@@ -28,6 +28,7 @@ namespace {
 }
 
 void check_dt(State& s) {
+  update_servo_stiffness(s);
   s.dt_estimate = estimate_critical_dt(s);
   s.last_estimate_step = s.step;
   if (!s.dt_fixed) {
@@ -150,7 +151,7 @@ double estimate_critical_dt(const State& s) {
   for (const Group& g : s.groups) {  // a group is one body
     double k = 0;
     for (std::int32_t i : g.members) k += ktran[i];
-    if (!g.members.empty()) best = std::min(best, std::sqrt(g.mass / (k > 0 ? k : kc)));
+    if (g.mass > 0) best = std::min(best, std::sqrt(g.mass / (k > 0 ? k : kc)));
   }
   for (std::size_t i = 0; i < n; ++i) {
     if (p.group[i] >= 0) continue;

@@ -57,14 +57,30 @@ void touch(State& s) {  // the user changed the state: rebuild, re-estimate, re-
 }
 
 void recompute_group(State& s, detail::Group& g) {
+  detail::sync_inert(s);
   const auto& p = s.p;
   g.mass = 0;
+  g.inert_mass = 0;
   Vec3 c{0, 0, 0};
   for (auto i : g.members) {
     g.mass += p.mass[i];
     c += Vec3{p.x[i], p.y[i], p.z[i]} * p.mass[i];
   }
+  for (auto i : g.inert) {
+    g.mass += p.mass[i];
+    g.inert_mass += p.mass[i];
+    c += Vec3{p.x[i], p.y[i], p.z[i]} * p.mass[i];
+  }
   g.centre = g.mass > 0 ? c / g.mass : Vec3{};
+}
+
+// Inert group members are moved lazily; reads bring them up to date first. This changes no
+// observable state, so const readers may do it.
+const State& synced(const State& s) {
+  bool pending = false;
+  for (const auto& g : s.groups) pending = pending || !(g.inert_shift == Vec3{});
+  if (pending) detail::sync_inert(const_cast<State&>(s));
+  return s;
 }
 
 }  // namespace
@@ -92,7 +108,7 @@ World::World(WorldSettings settings) : state_(std::make_unique<State>()) {
   require(settings.reorder_interval >= 0, "reorder_interval must be >= 0");
   require_finite(settings.gravity, "gravity");
   s.kernels = &kernels::select_kernels(settings.simd);
-  if (settings.threads == 0) settings.threads = omp_get_max_threads();
+  s.max_threads = omp_get_max_threads();
   s.settings = settings;
   s.dt_fixed = settings.dt > 0;
   s.dt = settings.dt;
@@ -185,12 +201,12 @@ std::size_t World::particle_count() const { return state_->p.n; }
   Vec3 { p.col##x[i], p.col##y[i], p.col##z[i] }
 
 Vec3 World::position(std::int64_t id) const {
-  const auto& p = state_->p;
+  const auto& p = synced(*state_).p;
   const auto i = index_of(*state_, id);
   return {p.x[i], p.y[i], p.z[i]};
 }
 Vec3 World::velocity(std::int64_t id) const {
-  const auto& p = state_->p;
+  const auto& p = synced(*state_).p;
   const auto i = index_of(*state_, id);
   return ASPERITY_VEC(v);
 }
@@ -282,7 +298,6 @@ void World::set_applied_force(std::int64_t id, Vec3 f) {
   p.az[i] = f.z;
 }
 void World::set_rotation_locked(std::int64_t id, bool locked) {
-  auto& p = state_->p;
   const auto i = index_of(*state_, id);
   require(state_->settings.rotation || locked,
           "rotation is disabled in this world (settings.rotation = false)");
@@ -309,8 +324,8 @@ std::vector<double> by_id(const State& s, const AVec<double>& a,
 }
 }  // namespace
 
-std::vector<double> World::positions() const { const auto& p = state_->p; return by_id(*state_, p.x, &p.y, &p.z); }
-std::vector<double> World::velocities() const { const auto& p = state_->p; return by_id(*state_, p.vx, &p.vy, &p.vz); }
+std::vector<double> World::positions() const { const auto& p = synced(*state_).p; return by_id(*state_, p.x, &p.y, &p.z); }
+std::vector<double> World::velocities() const { const auto& p = synced(*state_).p; return by_id(*state_, p.vx, &p.vy, &p.vz); }
 std::vector<double> World::forces() const { const auto& p = state_->p; return by_id(*state_, p.fx, &p.fy, &p.fz); }
 std::vector<double> World::radii() const { return by_id(*state_, state_->p.radius); }
 
@@ -433,7 +448,23 @@ void World::set_group_motion(int group, const GroupMotion& motion) {
   require_finite(motion.angular_velocity, "group angular velocity");
   require(state_->settings.rotation || motion.rotation == Dof::fixed,
           "group rotation needs a world with rotation enabled");
-  state_->groups[check_group(*state_, group)].motion = motion;
+  require(motion.rotation != Dof::servo, "rotation cannot be servo-controlled (translation only)");
+  auto& g = state_->groups[check_group(*state_, group)];
+  require(g.inert.empty() || motion.rotation == Dof::fixed,
+          "group " + std::to_string(group) + " has inert members: its rotation must stay fixed");
+  const char* axis[3] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k) {
+    if (motion.translation[k] != Dof::servo) continue;
+    const Servo& sv = motion.servo[k];
+    const std::string where = std::string("servo on ") + axis[k] + ": ";
+    require(std::isfinite(sv.target_force), where + "target_force must be finite");
+    require(std::isfinite(sv.stiffness) && sv.stiffness >= 0, where + "stiffness must be >= 0 (N/m)");
+    require(std::isfinite(sv.gain) && sv.gain >= 0, where + "gain must be >= 0 (0: automatic)");
+    require(sv.relaxation > 0 && sv.relaxation <= 1, where + "relaxation must be in (0, 1]");
+    require(sv.max_velocity > 0 && std::isfinite(sv.max_velocity), where + "max_velocity must be > 0 (m/s)");
+  }
+  g.motion = motion;
+  g.servo_origin = g.centre;
 }
 const GroupMotion& World::group_motion(int group) const { return state_->groups[check_group(*state_, group)].motion; }
 void World::set_group_applied_force(int group, Vec3 f) {
@@ -452,6 +483,75 @@ std::vector<std::int64_t> World::group_members(int group) const {
   return out;
 }
 std::size_t World::group_count() const { return state_->groups.size(); }
+
+void World::set_inert(std::span<const std::int64_t> ids, bool inert) {
+  State& s = *state_;
+  detail::sync_inert(s);
+  std::vector<std::size_t> idx;
+  for (auto id : ids) {
+    const auto i = index_of(s, id);
+    require(s.p.group[i] >= 0, "set_inert: particle " + std::to_string(id) +
+                                   " is not in a rigid group (only group members can be inert)");
+    require(s.groups[s.p.group[i]].motion.rotation == Dof::fixed,
+            "set_inert: group " + std::to_string(s.p.group[i]) + " rotates; inert members need a "
+            "group whose rotation is fixed");
+    idx.push_back(i);
+  }
+  for (auto i : idx) s.p.inert[i] = inert ? 1 : 0;
+  for (auto& g : s.groups) {
+    std::vector<std::int32_t> all(g.members);
+    all.insert(all.end(), g.inert.begin(), g.inert.end());
+    std::sort(all.begin(), all.end());
+    g.members.clear();
+    g.inert.clear();
+    for (auto i : all) (s.p.inert[i] ? g.inert : g.members).push_back(i);
+    recompute_group(s, g);
+  }
+  touch(s);
+}
+
+std::size_t World::inert_count() const {
+  std::size_t n = 0;
+  for (const auto& g : state_->groups) n += g.inert.size();
+  return n;
+}
+
+// --- labels --------------------------------------------------------------------------------
+
+void World::set_tag(std::span<const std::int64_t> ids, int tag) {
+  for (auto id : ids) state_->p.tag[index_of(*state_, id)] = tag;
+}
+int World::tag(std::int64_t id) const { return state_->p.tag[index_of(*state_, id)]; }
+void World::set_flags(std::span<const std::int64_t> ids, std::uint8_t flags) {
+  for (auto id : ids) state_->p.flags[index_of(*state_, id)] = flags;
+}
+std::uint8_t World::flags(std::int64_t id) const { return state_->p.flags[index_of(*state_, id)]; }
+
+ContactSummary World::contact_summary(int tag_a, int tag_b, std::uint8_t flag_mask) const {
+  const State& s = *state_;
+  const auto& p = s.p;
+  const auto& q = s.pairs;
+  ContactSummary out;
+  for (std::size_t k = 0; k < q.n; ++k) {
+    const double U = q.overlap[k];
+    if (!(U > 0)) continue;
+    const auto a = q.a[k], b = q.b[k];
+    double sign;  // force on the tag_b particle is sign * (force on b)
+    if (p.tag[a] == tag_a && p.tag[b] == tag_b) sign = 1;
+    else if (p.tag[a] == tag_b && p.tag[b] == tag_a) sign = -1;
+    else continue;
+    const Vec3 f = (Vec3{q.nx[k], q.ny[k], q.nz[k]} * q.fn[k] + Vec3{q.fsx[k], q.fsy[k], q.fsz[k]}) * sign;
+    const double Rm = 0.5 * (p.radius[a] + p.radius[b]);
+    ++out.count;
+    out.area += 3.14159265358979323846 * (Rm * U - 0.25 * U * U);  // [4-1, 4-2]
+    out.force += f;
+    if (flag_mask && ((p.flags[a] | p.flags[b]) & flag_mask)) {
+      ++out.flagged_count;
+      out.flagged_force += f;
+    }
+  }
+  return out;
+}
 
 // --- bonds ---------------------------------------------------------------------------------
 
@@ -608,7 +708,7 @@ std::uint64_t World::step_count() const { return state_->step; }
 double World::time() const { return state_->time; }
 void World::set_threads(int threads) {
   require(threads >= 0, "threads must be >= 0 (0: all cores)");
-  state_->settings.threads = threads == 0 ? omp_get_max_threads() : threads;
+  state_->settings.threads = threads;
 }
 std::string World::simd_architecture() const { return state_->kernels->name; }
 StepStats World::stats() const {

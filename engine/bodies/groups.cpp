@@ -6,6 +6,7 @@
 // Energy (model.md 8): the agent that holds a fixed or prescribed degree of freedom does the work
 // needed to make the group follow its prescription, F_agent = M dV/dt - F; that work is boundary
 // work. Gyroscopic terms of free rotation are neglected (quasi-static loading).
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Dense>
@@ -54,14 +55,28 @@ void advance_groups(State& s) {
     for (int k = 0; k < 3; ++k) {
       switch (grp.motion.translation[k]) {
         case Dof::free: {
-          const double fd = -alpha * std::fabs(Fk[k]) * sign(V[k]);
+          const double fd = -alpha * std::fabs(Fk[k] + M * gk[k]) * sign(V[k]);  // unbalanced
           Vn[k] = V[k] + (Fk[k] + fd) / M * dt + gk[k] * dt;
           damping_work -= fd * 0.5 * (V[k] + Vn[k]) * dt;
           break;
         }
         case Dof::fixed:
-        case Dof::velocity: {
-          Vn[k] = grp.motion.translation[k] == Dof::fixed ? 0.0 : Vp[k];
+        case Dof::velocity:
+        case Dof::servo: {
+          if (grp.motion.translation[k] == Dof::servo) {
+            // model.md 7: v = clamp(G (F - F_target), -vmax, vmax), target moving with CNS.
+            const Servo& sv = grp.motion.servo[k];
+            const double shift = grp.centre[k] - grp.servo_origin[k];
+            const double target = sv.target_force + sv.stiffness * shift;
+            const double error = Fk[k] - target;
+            double v;
+            if (sv.gain > 0) v = sv.gain * error;
+            else if (grp.contact_stiffness > 0) v = sv.relaxation / (grp.contact_stiffness * dt) * error;
+            else v = error > 0 ? sv.max_velocity : (error < 0 ? -sv.max_velocity : 0.0);
+            Vn[k] = std::clamp(v, -sv.max_velocity, sv.max_velocity);
+          } else {
+            Vn[k] = grp.motion.translation[k] == Dof::fixed ? 0.0 : Vp[k];
+          }
           const double agent = M * (Vn[k] - V[k]) / dt - (Fk[k] + M * gk[k]);
           agent_work += agent * 0.5 * (V[k] + Vn[k]) * dt;
           break;
@@ -110,6 +125,9 @@ void advance_groups(State& s) {
     grp.angular_velocity = Wnew;
     const Vec3 theta = Wnew * dt;
     const bool spins = !(Wnew == Vec3{});
+    // Inert members: only the shift is recorded; they are moved when someone reads them.
+    grp.inert_shift += Vnew * dt;
+    kinetic += 0.5 * grp.inert_mass * dot(Vmid, Vmid);
     for (std::int32_t i : grp.members) {
       Vec3 r = Vec3{p.x[i], p.y[i], p.z[i]} - old_centre;
       if (spins) r = rotate(r, theta);
@@ -124,6 +142,45 @@ void advance_groups(State& s) {
     }
   }
   s.kinetic_at_step = kinetic;  // the free particles' share is added in bookkeeping
+}
+
+void update_servo_stiffness(State& s) {
+  if (s.groups.empty()) return;
+  const ParticleStore& p = s.p;
+  std::vector<double> K(s.groups.size(), 0.0);
+  auto add = [&](std::int64_t a, std::int64_t b, double k) {
+    const int ga = p.group[a], gb = p.group[b];
+    if (ga == gb) return;
+    if (ga >= 0) K[ga] += k;
+    if (gb >= 0) K[gb] += k;
+  };
+  const double kn = s.settings.contact.kn;
+  for (std::size_t k = 0; k < s.pairs.n; ++k)
+    if (s.pairs.overlap[k] > 0) add(s.pairs.a[k], s.pairs.b[k], kn);
+  for (std::size_t k = 0; k < s.bonds.n; ++k) add(s.bonds.a[k], s.bonds.b[k], kn + s.bonds.material.beam_kn);
+  const WallContacts& wc = s.walls.contacts;
+  for (std::size_t k = 0; k < wc.n; ++k) {
+    const int g = p.group[wc.particle[k]];
+    if (g >= 0 && wc.overlap[k] > 0) K[g] += s.walls.walls[wc.wall[k]].material.kn;
+  }
+  for (std::size_t g = 0; g < s.groups.size(); ++g) s.groups[g].contact_stiffness = K[g];
+}
+
+void sync_inert(State& s) {
+  ParticleStore& p = s.p;
+  for (Group& g : s.groups) {
+    if (g.inert.empty()) continue;
+    const Vec3 d = g.inert_shift;
+    for (std::int32_t i : g.inert) {
+      p.x[i] += d.x;
+      p.y[i] += d.y;
+      p.z[i] += d.z;
+      p.vx[i] = g.velocity.x;
+      p.vy[i] = g.velocity.y;
+      p.vz[i] = g.velocity.z;
+    }
+    g.inert_shift = {0, 0, 0};
+  }
 }
 
 }  // namespace asperity::detail

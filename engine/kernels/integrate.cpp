@@ -18,9 +18,15 @@ inline double sign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
 // One degree of freedom of leapfrog with local damping. Returns the new velocity; adds the work
 // of the damping force (>= 0 when dissipating) using the mean of the old and new velocities,
 // which is what makes the kinetic-energy change of a step equal the work of its forces.
+//
+// The damping force is proportional to the unbalanced force, gravity included [3-28, model.md 2:
+// "steady motion under zero net force is not damped"]: a particle resting on a floor carries
+// F = -m g from its contacts and must feel no damping. Damping |F| without gravity would push it
+// up and down by alpha g dt every step, and a pile would never reach equilibrium.
 inline double advance(double v, double f, double inv_m, double accel, double alpha, double dt,
                       double& damping_work) {
-  const double fd = -alpha * std::fabs(f) * sign(v);  // [3-28]: opposes the motion
+  const double unbalanced = f + accel / inv_m;
+  const double fd = -alpha * std::fabs(unbalanced) * sign(v);  // [3-28]: opposes the motion
   const double vn = v + (f + fd) * inv_m * dt + accel * dt;
   damping_work -= fd * 0.5 * (v + vn) * dt;
   return vn;
@@ -46,6 +52,7 @@ void gather_and_integrate(State& s) {
     ParticleBlockResult r;
     const std::size_t end = std::min(n, (blk + 1) * kParticleBlock);
     for (std::size_t i = blk * kParticleBlock; i < end; ++i) {
+      if (p.inert[i]) continue;  // no contacts, moved lazily with its group
       double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
       const double R = p.radius[i];
       for (std::int32_t e = inc.start[i]; e < inc.start[i + 1]; ++e) {

@@ -44,6 +44,7 @@ CellGrid make_grid(const ParticleStore& p, double skin) {
   const std::size_t n = p.n;
   double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, rmax = 0;
   for (std::size_t i = 0; i < n; ++i) {
+    if (p.inert[i]) continue;
     const double c[3] = {p.x[i], p.y[i], p.z[i]};
     for (int d = 0; d < 3; ++d) {
       lo[d] = std::min(lo[d], c[d]);
@@ -58,6 +59,7 @@ CellGrid make_grid(const ParticleStore& p, double skin) {
   auto dims = [&](double cell, int d) {
     return static_cast<int>(std::min(1e6, std::floor((hi[d] - lo[d]) / cell) + 1));
   };
+  if (lo[0] > hi[0]) lo[0] = lo[1] = lo[2] = hi[0] = hi[1] = hi[2] = 0;  // nothing to bin
   while (double(dims(g.cell, 0)) * dims(g.cell, 1) * dims(g.cell, 2) > 2.0 * double(n) + 64)
     g.cell *= 1.26;
   g.ox = lo[0];
@@ -69,16 +71,24 @@ CellGrid make_grid(const ParticleStore& p, double skin) {
   const std::size_t cells = std::size_t(g.nx) * g.ny * g.nz;
   g.cell_of.resize(n);
   g.start.assign(cells + 1, 0);
+  // Inert particles (interior of a rigid body) are not binned at all.
+  std::size_t binned = 0;
   for (std::size_t i = 0; i < n; ++i) {
+    if (p.inert[i]) {
+      g.cell_of[i] = -1;
+      continue;
+    }
     int a, b, c;
     g.coords(p.x[i], p.y[i], p.z[i], a, b, c);
     g.cell_of[i] = static_cast<std::int32_t>((std::size_t(c) * g.ny + b) * g.nx + a);
     ++g.start[g.cell_of[i] + 1];
+    ++binned;
   }
   std::partial_sum(g.start.begin(), g.start.end(), g.start.begin());
-  g.members.resize(n);
+  g.members.resize(binned);
   std::vector<std::int32_t> fill(g.start.begin(), g.start.end() - 1);
-  for (std::size_t i = 0; i < n; ++i) g.members[fill[g.cell_of[i]]++] = std::int32_t(i);
+  for (std::size_t i = 0; i < n; ++i)
+    if (g.cell_of[i] >= 0) g.members[fill[g.cell_of[i]]++] = std::int32_t(i);
   return g;
 }
 
@@ -196,8 +206,10 @@ void reorder(State& s, const CellGrid& g) {
     ih.b[k] = b;
   }
   for (auto& grp : s.groups) {
-    for (auto& m : grp.members) m = std::int32_t(new_index[m]);
-    std::sort(grp.members.begin(), grp.members.end());
+    for (auto* list : {&grp.members, &grp.inert}) {
+      for (auto& m : *list) m = std::int32_t(new_index[m]);
+      std::sort(list->begin(), list->end());
+    }
   }
   s.user_rotation_locked.resize(p.n, 0);
   {
@@ -220,6 +232,7 @@ inline bool bonded(const State& s, std::size_t i, std::int32_t o) {
 template <class Out>
 void neighbours_of(const State& s, const CellGrid& g, std::size_t i, Out&& out) {
   const ParticleStore& p = s.p;
+  if (p.inert[i]) return;
   int ci, cj, ck;
   g.coords(p.x[i], p.y[i], p.z[i], ci, cj, ck);
   const double reach = p.radius[i] + s.skin;
@@ -322,6 +335,7 @@ void build_wall_contacts(State& s) {
     std::vector<std::int32_t> tris;
 #pragma omp for schedule(dynamic, 256)
     for (std::size_t i = 0; i < n; ++i) {
+      if (p.inert[i]) continue;
       const Vec3 c{p.x[i], p.y[i], p.z[i]};
       const double reach = p.radius[i] + s.skin;
       for (std::size_t w = 0; w < walls.size(); ++w) {
@@ -403,6 +417,7 @@ void build_neighbors(State& s) {
   build_pairs(s, grid);
   build_wall_contacts(s);
   for (std::size_t i = 0; i < p.n; ++i) {
+    if (p.inert[i]) continue;
     p.x0[i] = p.x[i];
     p.y0[i] = p.y[i];
     p.z0[i] = p.z[i];

@@ -25,6 +25,9 @@ void ParticleStore::resize(std::size_t new_n) {
   density.resize(new_n, 0.0);
   rotation_locked.resize(cap, 1);
   group.resize(cap, -1);
+  tag.resize(cap, 0);
+  flags.resize(cap, 0);
+  inert.resize(cap, 0);
   id.resize(cap, -1);
   n = new_n;
   capacity = cap;
@@ -36,6 +39,9 @@ void ParticleStore::resize(std::size_t new_n) {
     radius[i] = mass[i] = inv_mass[i] = inertia[i] = inv_inertia[i] = 0;
     rotation_locked[i] = 1;
     group[i] = -1;
+    tag[i] = 0;
+    flags[i] = 0;
+    inert[i] = 0;
     id[i] = -1;
   }
 }
@@ -49,6 +55,9 @@ void ParticleStore::permute(const std::vector<std::int32_t>& order) {
   permute_column(density, order);
   permute_column(rotation_locked, order);
   permute_column(group, order);
+  permute_column(tag, order);
+  permute_column(flags, order);
+  permute_column(inert, order);
   permute_column(id, order);
   for (std::size_t i = 0; i < n; ++i) index_of_id[id[i]] = static_cast<std::int64_t>(i);
 }

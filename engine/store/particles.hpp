@@ -28,6 +28,9 @@ struct ParticleStore {
   std::vector<double> density;
   std::vector<std::uint8_t> rotation_locked;
   std::vector<std::int32_t> group;  // -1: none
+  std::vector<std::int32_t> tag;    // user label
+  std::vector<std::uint8_t> flags;  // user bits
+  std::vector<std::uint8_t> inert;  // never searched, moved lazily with its group
   std::vector<std::int64_t> id;     // stable id of the particle at this index
   std::vector<std::int64_t> index_of_id;  // stable id -> current index
 

@@ -53,19 +53,36 @@ struct WorldSettings {
   double dt_safety = 0.8;
   bool allow_dt_above_estimate = false;  // a fixed dt above the estimate is an error unless set
   int dt_interval = 100;            // steps between critical-step estimates (also at each rebuild)
-  int threads = 0;                  // OpenMP threads; 0: all available
+  int threads = 0;                  // OpenMP threads; 0: automatic (1 per 20 000 particles, up to
+                                    // the cores available)
   std::string simd = "auto";        // "auto", "scalar", "sse4_2", "avx2", "avx512f"
   bool track_energy = true;         // friction, damping and boundary work ledgers (model.md 8)
   int reorder_interval = 10;        // neighbour rebuilds between space-filling-curve reorders; 0: never
   bool lock_bonded_rotation = true; // a particle holding an intact bond does not rotate (model.md 2)
 };
 
-// How a rigid group's degree of freedom moves (model.md 1).
-enum class Dof : std::uint8_t { free, fixed, velocity };
+// How a rigid group's degree of freedom moves (model.md 1, 7).
+enum class Dof : std::uint8_t { free, fixed, velocity, servo };
+
+// Force control of one translational degree of freedom (model.md 7): each step the axis moves at
+// v = clamp(G (F - F_target), -max_velocity, max_velocity), where F is the force the particles
+// exert on the group along the axis. With stiffness > 0 (constant normal stiffness, CNS) the
+// target follows the displacement since the servo was engaged: F_target = target_force +
+// stiffness * displacement. Sign convention: a top platen pressing down feels F > 0, so its
+// target is positive; a bottom platen's is negative.
+struct Servo {
+  double target_force = 0;    // N
+  double stiffness = 0;       // N/m; 0: constant normal load (CNL)
+  double gain = 0;            // m/s per N; 0: automatic, relaxation / (K dt) with K the summed
+                              // stiffness of the group's contacts
+  double relaxation = 0.2;    // fraction of the force error corrected per step (automatic gain)
+  double max_velocity = 1e-3; // m/s
+};
 
 struct GroupMotion {
   std::array<Dof, 3> translation{Dof::free, Dof::free, Dof::free};
   Vec3 velocity{0, 0, 0};          // used on the axes whose mode is Dof::velocity
+  std::array<Servo, 3> servo{};    // used on the axes whose mode is Dof::servo
   Dof rotation = Dof::fixed;       // all three rotational axes together (the thesis locks them)
   Vec3 angular_velocity{0, 0, 0};  // used when rotation == Dof::velocity
 };
@@ -77,6 +94,15 @@ struct ContactInfo {  // one ball-ball contact (touching pair), for inspection a
   double overlap;      // U > 0
   double normal_force; // Fn >= 0, acting on b along normal
   Vec3 shear_force;    // Fs on b
+};
+
+// Contacts between particles of two tags (e.g. the two halves of a joint), summed.
+struct ContactSummary {
+  std::size_t count = 0;      // touching ball-ball contacts between the tags
+  double area = 0;            // sum of pi a^2, a^2 = Rm U - U^2/4 [4-1], m^2
+  Vec3 force{0, 0, 0};        // total force on the tag_b particles from the tag_a particles
+  std::size_t flagged_count = 0;  // of those, contacts with a particle carrying flag_mask
+  Vec3 flagged_force{0, 0, 0};
 };
 
 struct BondInfo {  // one intact bond, for inspection and output
@@ -197,6 +223,19 @@ class World {
   double group_mass(int group) const;
   std::vector<std::int64_t> group_members(int group) const;
   std::size_t group_count() const;
+  // Members of a translating group (rotation fixed) that can never touch anything (the interior
+  // of a rigid half): left out of the neighbour search and not moved every step; their positions
+  // follow the group when read. The cost of a rigid body then scales with its surface.
+  void set_inert(std::span<const std::int64_t> ids, bool inert = true);
+  std::size_t inert_count() const;
+
+  // --- labels --------------------------------------------------------------------------------
+  // A tag (integer label, default 0) and flag bits (default 0) per particle, for measurements.
+  void set_tag(std::span<const std::int64_t> ids, int tag);
+  int tag(std::int64_t id) const;
+  void set_flags(std::span<const std::int64_t> ids, std::uint8_t flags);
+  std::uint8_t flags(std::int64_t id) const;
+  ContactSummary contact_summary(int tag_a, int tag_b, std::uint8_t flag_mask = 0) const;
 
   // --- bonds (model.md 5) ----------------------------------------------------------------
   // Bond every pair whose gap d - Ra - Rb <= tolerance (tolerance < 0: 1e-3 x mean radius), at

@@ -17,7 +17,7 @@ TEST(Determinism, FullStateBitwiseIdenticalWithOneAndTwoThreads) {
   World a = test::random_box(3000, one), b = test::random_box(3000, two);
   a.cycle(1500);
   b.cycle(1500);
-  ASSERT_GT(a.contact_count(), 1000u);
+  ASSERT_GT(a.contact_count(), 500u) << "the scene must be busy";
   auto same = [](const std::vector<double>& u, const std::vector<double>& v) {
     return u.size() == v.size() && std::memcmp(u.data(), v.data(), u.size() * sizeof(double)) == 0;
   };

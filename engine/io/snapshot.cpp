@@ -1,0 +1,263 @@
+// Particle snapshots: one HDF5 file per snapshot and an XDMF index over them.
+//
+// Why one file per snapshot rather than one growing file: each file can then be written under a
+// temporary name and renamed when complete, so an interrupted run leaves only whole snapshots,
+// and ParaView can reload the series while the run is still writing it.
+//
+// XDMF (www.xdmf.org, version 3 light data): a Temporal collection of Uniform grids. Particles
+// are a Polyvertex topology over their positions, with an explicit connectivity 0..n-1 (stored
+// as /particles/index) rather than the implicit form, which some readers handle differently.
+// Contacts are a Polyline topology with two nodes per element, the two particles' rows, over the
+// same positions: ParaView then draws the force chains as lines and colours them by force.
+#include <cstdio>
+#include <sstream>
+#include <unordered_map>
+
+#include "asperity/io.hpp"
+#include "asperity/world.hpp"
+#include "io/hdf5_file.hpp"
+
+namespace asperity::io {
+
+Snapshot take_snapshot(const World& world, bool with_contacts, std::int64_t id_base) {
+  Snapshot s;
+  s.step = world.step_count();
+  s.time = world.time();
+  s.id_base = id_base;
+  std::size_t n = world.particle_count();
+  s.position = world.positions();
+  s.velocity = world.velocities();
+  s.radius = world.radii();
+  s.id.resize(n);
+  s.group.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    auto id = static_cast<std::int64_t>(i);
+    s.id[i] = id + id_base;
+    int g = world.group_of(id);
+    s.group[i] = g < 0 ? -1 : static_cast<std::int32_t>(g + id_base);
+  }
+  if (with_contacts) {
+    s.has_contacts = true;
+    std::vector<ContactInfo> cs = world.contacts();
+    std::size_t m = cs.size();
+    s.id_a.resize(m);
+    s.id_b.resize(m);
+    s.index_a.resize(m);
+    s.index_b.resize(m);
+    s.overlap.resize(m);
+    s.normal_force.resize(m);
+    s.normal.resize(3 * m);
+    s.point.resize(3 * m);
+    s.shear_force.resize(3 * m);
+    for (std::size_t k = 0; k < m; ++k) {
+      const ContactInfo& c = cs[k];
+      // Bulk reads are in id order, so the row of a particle is its id.
+      s.index_a[k] = static_cast<std::int32_t>(c.id_a);
+      s.index_b[k] = static_cast<std::int32_t>(c.id_b);
+      s.id_a[k] = c.id_a + id_base;
+      s.id_b[k] = c.id_b + id_base;
+      s.overlap[k] = c.overlap;
+      s.normal_force[k] = c.normal_force;
+      for (int d = 0; d < 3; ++d) {
+        s.normal[3 * k + d] = c.normal[d];
+        s.point[3 * k + d] = c.point[d];
+        s.shear_force[3 * k + d] = c.shear_force[d];
+      }
+    }
+  }
+  if (world.bond_count() > 0) {
+    s.has_bonds = true;
+    for (const BondInfo& b : world.bonds()) {
+      s.bond_index_a.push_back(static_cast<std::int32_t>(b.id_a));
+      s.bond_index_b.push_back(static_cast<std::int32_t>(b.id_b));
+      s.bond_id_a.push_back(b.id_a + id_base);
+      s.bond_id_b.push_back(b.id_b + id_base);
+      s.bond_normal_force.push_back(b.normal_force);
+      s.bond_shear_force.insert(s.bond_shear_force.end(), {b.shear_force.x, b.shear_force.y, b.shear_force.z});
+      s.bond_sigma.push_back(b.sigma);
+      s.bond_tau.push_back(b.tau);
+      s.bond_gap.push_back(b.gap);
+    }
+  }
+  return s;
+}
+
+namespace {
+std::vector<std::int32_t> interleave(const std::vector<std::int32_t>& a, const std::vector<std::int32_t>& b) {
+  std::vector<std::int32_t> out(2 * a.size());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    out[2 * k] = a[k];
+    out[2 * k + 1] = b[k];
+  }
+  return out;
+}
+}  // namespace
+
+void write_snapshot_hdf5(const std::filesystem::path& path, const Snapshot& s) {
+  const std::string name = path.string();
+  std::size_t n = s.id.size();
+  if (s.position.size() != 3 * n || s.velocity.size() != 3 * n || s.radius.size() != n ||
+      s.group.size() != n)
+    throw Error("snapshot for '" + name + "': particle arrays of unequal length");
+  AtomicFile file(path);
+  {
+    h5::Handle f = h5::create_file(file.temp_path());
+    h5::write_attribute(f, "step", static_cast<std::int64_t>(s.step), name);
+    h5::write_attribute(f, "time", s.time, name);
+    h5::write_attribute(f, "id_base", s.id_base, name);
+    h5::write_attributes(f, s.attributes, name);
+    {
+      h5::Handle g = h5::create_group(f, "particles", name);
+      h5::write_int64(g, "id", s.id, 0, "", name);
+      h5::write_doubles(g, "position", s.position, 3, "m", name);
+      h5::write_doubles(g, "velocity", s.velocity, 3, "m/s", name);
+      h5::write_doubles(g, "radius", s.radius, 0, "m", name);
+      h5::write_int32(g, "group", s.group, 0, "", name);
+      std::vector<std::int32_t> index(n);
+      for (std::size_t i = 0; i < n; ++i) index[i] = static_cast<std::int32_t>(i);
+      h5::write_int32(g, "index", index, 0, "", name);
+    }
+    if (s.has_contacts) {
+      h5::Handle g = h5::create_group(f, "contacts", name);
+      h5::write_int64(g, "id_a", s.id_a, 0, "", name);
+      h5::write_int64(g, "id_b", s.id_b, 0, "", name);
+      h5::write_int32(g, "pair", interleave(s.index_a, s.index_b), 2, "", name);
+      h5::write_doubles(g, "normal", s.normal, 3, "", name);
+      h5::write_doubles(g, "point", s.point, 3, "m", name);
+      h5::write_doubles(g, "overlap", s.overlap, 0, "m", name);
+      h5::write_doubles(g, "normal_force", s.normal_force, 0, "N", name);
+      h5::write_doubles(g, "shear_force", s.shear_force, 3, "N", name);
+    }
+    if (s.has_bonds) {
+      h5::Handle g = h5::create_group(f, "bonds", name);
+      h5::write_int64(g, "id_a", s.bond_id_a, 0, "", name);
+      h5::write_int64(g, "id_b", s.bond_id_b, 0, "", name);
+      h5::write_int32(g, "pair", interleave(s.bond_index_a, s.bond_index_b), 2, "", name);
+      h5::write_doubles(g, "normal_force", s.bond_normal_force, 0, "N", name);
+      h5::write_doubles(g, "shear_force", s.bond_shear_force, 3, "N", name);
+      h5::write_doubles(g, "sigma", s.bond_sigma, 0, "Pa", name);
+      h5::write_doubles(g, "tau", s.bond_tau, 0, "Pa", name);
+      h5::write_doubles(g, "gap", s.bond_gap, 0, "m", name);
+    }
+    if (H5Fflush(f, H5F_SCOPE_LOCAL) < 0) throw Error("HDF5 file '" + name + "': flush failed");
+  }
+  file.commit();
+}
+
+SnapshotSeries::SnapshotSeries(std::filesystem::path directory, std::string name)
+    : directory_(std::move(directory)), name_(std::move(name)) {
+  if (name_.empty() || name_.find('/') != std::string::npos)
+    throw Error("snapshot series name '" + name_ + "' must be a plain file name");
+  make_directories(directory_);
+}
+
+std::filesystem::path SnapshotSeries::xdmf_path() const { return directory_ / (name_ + ".xdmf"); }
+std::filesystem::path SnapshotSeries::contacts_xdmf_path() const {
+  return directory_ / (name_ + "_contacts.xdmf");
+}
+std::filesystem::path SnapshotSeries::bonds_xdmf_path() const {
+  return directory_ / (name_ + "_bonds.xdmf");
+}
+
+std::filesystem::path SnapshotSeries::write(const Snapshot& snapshot) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "_%06zu.h5", entries_.size());
+  std::string file = name_ + buf;
+  write_snapshot_hdf5(directory_ / file, snapshot);
+  entries_.push_back(Entry{file, snapshot.step, snapshot.time, snapshot.id.size(),
+                           snapshot.id_a.size(), snapshot.bond_id_a.size(), snapshot.has_contacts,
+                           snapshot.has_bonds});
+  write_xdmf();
+  return directory_ / file;
+}
+
+namespace {
+std::string data_item(const std::string& file, const std::string& dataset, std::size_t rows,
+                      std::size_t cols, const char* number_type, int precision) {
+  std::ostringstream o;
+  o << "<DataItem Dimensions=\"" << rows;
+  if (cols) o << ' ' << cols;
+  o << "\" NumberType=\"" << number_type << "\" Precision=\"" << precision
+    << "\" Format=\"HDF\">" << file << ':' << dataset << "</DataItem>";
+  return o.str();
+}
+
+std::string time_text(double t) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", t);
+  return buf;
+}
+}  // namespace
+
+void SnapshotSeries::write_xdmf() const {
+  std::ostringstream p, c, b;
+  const char* head = "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n";
+  p << head << "  <Grid Name=\"" << name_ << "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  c << head << "  <Grid Name=\"" << name_ << "_contacts\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  b << head << "  <Grid Name=\"" << name_ << "_bonds\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  bool any_contacts = false, any_bonds = false;
+  for (const Entry& e : entries_) {
+    const std::string& f = e.file;
+    std::size_t n = e.particles;
+    std::string geometry = "    <Geometry GeometryType=\"XYZ\">" +
+                           data_item(f, "/particles/position", n, 3, "Float", 8) + "</Geometry>\n";
+    p << "   <Grid Name=\"step " << e.step << "\" GridType=\"Uniform\">\n"
+      << "    <Time Value=\"" << time_text(e.time) << "\"/>\n"
+      << "    <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << n
+      << "\" NodesPerElement=\"1\">" << data_item(f, "/particles/index", n, 0, "Int", 4)
+      << "</Topology>\n"
+      << geometry;
+    auto attribute = [&](std::ostringstream& o, const char* name, const char* type,
+                         const char* center, const std::string& item) {
+      o << "    <Attribute Name=\"" << name << "\" AttributeType=\"" << type << "\" Center=\""
+        << center << "\">" << item << "</Attribute>\n";
+    };
+    attribute(p, "id", "Scalar", "Node", data_item(f, "/particles/id", n, 0, "Int", 8));
+    attribute(p, "radius", "Scalar", "Node", data_item(f, "/particles/radius", n, 0, "Float", 8));
+    attribute(p, "velocity", "Vector", "Node",
+              data_item(f, "/particles/velocity", n, 3, "Float", 8));
+    attribute(p, "group", "Scalar", "Node", data_item(f, "/particles/group", n, 0, "Int", 4));
+    p << "   </Grid>\n";
+    if (e.has_contacts) {
+      any_contacts = true;
+      std::size_t m = e.contacts;
+      c << "   <Grid Name=\"step " << e.step << "\" GridType=\"Uniform\">\n"
+        << "    <Time Value=\"" << time_text(e.time) << "\"/>\n"
+        << "    <Topology TopologyType=\"Polyline\" NumberOfElements=\"" << m
+        << "\" NodesPerElement=\"2\">" << data_item(f, "/contacts/pair", m, 2, "Int", 4)
+        << "</Topology>\n"
+        << geometry;
+      attribute(c, "normal_force", "Scalar", "Cell",
+                data_item(f, "/contacts/normal_force", m, 0, "Float", 8));
+      attribute(c, "overlap", "Scalar", "Cell", data_item(f, "/contacts/overlap", m, 0, "Float", 8));
+      attribute(c, "shear_force", "Vector", "Cell",
+                data_item(f, "/contacts/shear_force", m, 3, "Float", 8));
+      attribute(c, "normal", "Vector", "Cell", data_item(f, "/contacts/normal", m, 3, "Float", 8));
+      c << "   </Grid>\n";
+    }
+    if (e.has_bonds) {
+      any_bonds = true;
+      std::size_t m = e.bonds;
+      b << "   <Grid Name=\"step " << e.step << "\" GridType=\"Uniform\">\n"
+        << "    <Time Value=\"" << time_text(e.time) << "\"/>\n"
+        << "    <Topology TopologyType=\"Polyline\" NumberOfElements=\"" << m
+        << "\" NodesPerElement=\"2\">" << data_item(f, "/bonds/pair", m, 2, "Int", 4)
+        << "</Topology>\n"
+        << geometry;
+      attribute(b, "normal_force", "Scalar", "Cell", data_item(f, "/bonds/normal_force", m, 0, "Float", 8));
+      attribute(b, "sigma", "Scalar", "Cell", data_item(f, "/bonds/sigma", m, 0, "Float", 8));
+      attribute(b, "tau", "Scalar", "Cell", data_item(f, "/bonds/tau", m, 0, "Float", 8));
+      attribute(b, "shear_force", "Vector", "Cell", data_item(f, "/bonds/shear_force", m, 3, "Float", 8));
+      b << "   </Grid>\n";
+    }
+  }
+  const char* tail = "  </Grid>\n </Domain>\n</Xdmf>\n";
+  p << tail;
+  c << tail;
+  b << tail;
+  write_text_file(xdmf_path(), p.str());
+  if (any_contacts) write_text_file(contacts_xdmf_path(), c.str());
+  if (any_bonds) write_text_file(bonds_xdmf_path(), b.str());
+}
+
+}  // namespace asperity::io

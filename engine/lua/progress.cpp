@@ -1,0 +1,97 @@
+#include "lua/progress.hpp"
+
+#include <sys/ioctl.h>
+#include <unistd.h>
+
+#include <cstdio>
+
+namespace asperity::lua {
+
+namespace {
+constexpr double kDelay = 2.0;     // s before the first draw
+constexpr double kInterval = 0.25; // s between draws
+
+std::string duration_text(double s) {
+  char buf[32];
+  long t = static_cast<long>(s + 0.5);
+  if (t >= 3600) std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", t / 3600, t / 60 % 60, t % 60);
+  else std::snprintf(buf, sizeof buf, "%ld:%02ld", t / 60, t % 60);
+  return buf;
+}
+
+std::string rate_text(double r) {
+  char buf[32];
+  if (r >= 1e6) std::snprintf(buf, sizeof buf, "%.1fM", r / 1e6);
+  else if (r >= 1e3) std::snprintf(buf, sizeof buf, "%.1fk", r / 1e3);
+  else std::snprintf(buf, sizeof buf, "%.0f", r);
+  return buf;
+}
+}  // namespace
+
+Progress::Progress(bool wanted, std::uint64_t total_steps)
+    : enabled_(wanted && ::isatty(STDERR_FILENO)), total_(total_steps), start_(Clock::now()),
+      last_(start_) {}
+
+Progress::~Progress() {
+  if (drawn_) {
+    std::fputs("\r\033[K", stderr);
+    std::fflush(stderr);
+  }
+}
+
+bool Progress::due() {
+  if (!enabled_) return false;
+  auto now = Clock::now();
+  return std::chrono::duration<double>(now - start_).count() >= kDelay &&
+         (!drawn_ || std::chrono::duration<double>(now - last_).count() >= kInterval);
+}
+
+void Progress::draw(std::uint64_t done, const std::string& extra) {
+  auto now = Clock::now();
+  double since_last = std::chrono::duration<double>(now - last_).count();
+  double instant = since_last > 0 ? double(done - last_done_) / since_last : 0;
+  rate_ = drawn_ ? 0.7 * rate_ + 0.3 * instant
+                 : double(done) / std::chrono::duration<double>(now - start_).count();
+  last_ = now;
+  last_done_ = done;
+  drawn_ = true;
+
+  std::string line;
+  char buf[96];
+  if (total_) {
+    double f = double(done) / double(total_);
+    int width = 20, filled = static_cast<int>(f * width);
+    line = "[" + std::string(static_cast<std::size_t>(filled), '#') +
+           std::string(static_cast<std::size_t>(width - filled), '-') + "]";
+    std::snprintf(buf, sizeof buf, " %5.1f%%  %llu/%llu", 100 * f, (unsigned long long)done,
+                  (unsigned long long)total_);
+    line += buf;
+  } else {
+    std::snprintf(buf, sizeof buf, "step %llu", (unsigned long long)done);
+    line = buf;
+  }
+  line += "  " + rate_text(rate_) + " steps/s";
+  double elapsed = std::chrono::duration<double>(now - start_).count();
+  line += "  " + duration_text(elapsed);
+  if (total_ && rate_ > 0) line += "  ETA " + duration_text(double(total_ - done) / rate_);
+  if (!extra.empty()) line += "  " + extra;
+  winsize ws{};
+  if (::ioctl(STDERR_FILENO, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 1 && line.size() >= ws.ws_col)
+    line.resize(ws.ws_col - 1);
+  std::fprintf(stderr, "\r\033[K%s", line.c_str());
+  std::fflush(stderr);
+}
+
+void Progress::finish(std::uint64_t done, const std::string& reason) {
+  if (drawn_) {
+    double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
+    std::fprintf(stderr, "\r\033[K%llu steps in %s (%s steps/s)%s%s\n", (unsigned long long)done,
+                 duration_text(elapsed).c_str(), rate_text(double(done) / elapsed).c_str(),
+                 reason.empty() ? "" : ", ", reason.c_str());
+    std::fflush(stderr);
+    drawn_ = false;
+  }
+  enabled_ = false;
+}
+
+}  // namespace asperity::lua

@@ -1,0 +1,142 @@
+// Loading control (model.md 7): the CNL and CNS servo on a group's normal degree of freedom,
+// inert members of a rigid body, and contact summaries between tagged particle sets.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "asperity/world.hpp"
+
+using namespace asperity;
+
+namespace {
+constexpr double kR = 5e-4;
+
+// A 4 x 4 x 3 lattice of spheres on a floor plane, under a 5 x 5 platen group.
+struct Column {
+  World w;
+  int platen;
+  std::vector<std::int64_t> bed, top, cover;
+};
+
+// With `cover`, a second platen layer above the first: it can never touch anything.
+Column column(GroupMotion motion, bool cover = false) {
+  WorldSettings ws;
+  ws.rotation = false;
+  Column c{World(ws), -1, {}, {}, {}};
+  c.w.add_plane({0, 0, 0}, {0, 0, 1});
+  const double a = 1.98 * kR;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      for (int k = 0; k < 3; ++k)
+        c.bed.push_back(c.w.add_particle({(i + 0.5) * a, (j + 0.5) * a, kR + k * a}, kR));
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j)
+      c.top.push_back(c.w.add_particle({i * a, j * a, kR + 2 * a + 2.02 * kR}, kR));
+  std::vector<std::int64_t> members = c.top;
+  if (cover)
+    for (int i = 0; i < 5; ++i)
+      for (int j = 0; j < 5; ++j) {
+        c.cover.push_back(c.w.add_particle({i * a, j * a, kR + 3 * a + 2.02 * kR}, kR));
+        members.push_back(c.cover.back());
+      }
+  c.platen = c.w.add_group(members, motion);
+  return c;
+}
+
+GroupMotion servo_z(double target, double stiffness = 0) {
+  GroupMotion m;
+  m.translation = {Dof::fixed, Dof::fixed, Dof::servo};
+  m.servo[2].target_force = target;
+  m.servo[2].stiffness = stiffness;
+  m.servo[2].max_velocity = 1e-4;
+  return m;
+}
+}  // namespace
+
+TEST(Servo, ConstantNormalLoadIsHeldWithinOnePercent) {
+  const double target = 2e-5;
+  Column c = column(servo_z(target));
+  c.w.cycle(20000);
+  EXPECT_NEAR(c.w.group_force(c.platen).z, target, 0.001 * target) << "settled on the target";
+  EXPECT_NEAR(c.w.wall_force(0).z, -target, 0.01 * target) << "the floor carries the load";
+  // Double the load: the servo follows, and stays within 1 % once there.
+  GroupMotion m = servo_z(2 * target);
+  c.w.set_group_motion(c.platen, m);
+  c.w.cycle(20000);
+  double worst = 0;
+  for (int k = 0; k < 50; ++k) {
+    c.w.cycle(100);
+    worst = std::max(worst, std::fabs(c.w.group_force(c.platen).z / (2 * target) - 1));
+  }
+  EXPECT_LT(worst, 0.01);
+}
+
+TEST(Servo, ConstantNormalStiffnessTargetFollowsTheDisplacement) {
+  const double F0 = 1e-5, K = 0.05;
+  Column c = column(servo_z(F0, K));
+  const double z0 = c.w.group_position(c.platen).z;
+  c.w.cycle(30000);
+  const double dz = c.w.group_position(c.platen).z - z0;
+  EXPECT_LT(dz, 0) << "the platen moved down onto the bed";
+  EXPECT_NEAR(c.w.group_force(c.platen).z, F0 + K * dz, 0.002 * F0);
+}
+
+TEST(Servo, BadServoParametersAreRefused) {
+  GroupMotion m = servo_z(1e-5);
+  m.servo[2].max_velocity = 0;
+  EXPECT_THROW(column(m), Error);
+  m = servo_z(1e-5);
+  m.servo[2].relaxation = 2;
+  EXPECT_THROW(column(m), Error);
+}
+
+TEST(Inert, InteriorOfARigidBodyIsNeitherSearchedNorChanged) {
+  // The platen's upper members cannot touch anything: made inert, the run is the same to
+  // rounding, they follow the group exactly, and they are not in the neighbour list.
+  GroupMotion m;
+  m.translation = {Dof::fixed, Dof::fixed, Dof::velocity};
+  m.velocity = {0, 0, -2e-6};
+  auto build = [&](bool inert) {
+    Column c = column(m, true);
+    if (inert) c.w.set_inert(c.cover);
+    std::vector<std::int64_t> corners{c.cover[0], c.cover[24]};
+    return std::make_pair(std::move(c), corners);
+  };
+  auto [plain, corners] = build(false);
+  auto [lazy, corners2] = build(true);
+  EXPECT_EQ(lazy.w.inert_count(), 25u);
+  const Vec3 p0 = lazy.w.position(corners[0]);
+  const double g0 = lazy.w.group_position(lazy.platen).z;
+  plain.w.cycle(3000);
+  lazy.w.cycle(3000);
+  EXPECT_EQ(lazy.w.stats().pairs, plain.w.stats().pairs);
+  EXPECT_NEAR(lazy.w.group_force(lazy.platen).z, plain.w.group_force(plain.platen).z,
+              1e-9 * std::fabs(plain.w.group_force(plain.platen).z));
+  const Vec3 p1 = lazy.w.position(corners[0]);
+  EXPECT_NEAR(p1.z - p0.z, lazy.w.group_position(lazy.platen).z - g0, 1e-15)
+      << "inert members follow the group when read";
+  EXPECT_NEAR(p1.z, plain.w.position(corners[0]).z, 1e-15);
+  EXPECT_THROW(lazy.w.set_inert(std::vector<std::int64_t>{lazy.bed[0]}), Error)
+      << "only group members can be inert";
+}
+
+TEST(ContactSummary, CountsAreaAndForceBetweenTags) {
+  World w;
+  const auto a = w.add_particle({0, 0, 0}, kR);
+  const auto b = w.add_particle({0, 0, 1.9 * kR}, 1.2 * kR);  // overlap U = 0.3 R
+  const auto c = w.add_particle({5e-3, 0, 0}, kR);
+  w.set_tag(std::vector<std::int64_t>{b}, 1);
+  w.set_flags(std::vector<std::int64_t>{a}, 2);
+  (void)c;
+  w.set_dt(1e-9);
+  w.cycle(1);
+  const ContactSummary s = w.contact_summary(0, 1, 2);
+  ASSERT_EQ(s.count, 1u);
+  const double U = 0.3 * kR, Rm = 1.1 * kR;
+  EXPECT_NEAR(s.area, std::numbers::pi * (Rm * U - U * U / 4), 1e-18);  // [4-1]
+  EXPECT_NEAR(s.force.z, 0.1 * U, 1e-12) << "pushes the tag-1 particle up";
+  EXPECT_EQ(s.flagged_count, 1u);
+  EXPECT_EQ(w.contact_summary(1, 0).force.z, -s.force.z);
+  EXPECT_EQ(w.contact_summary(0, 2).count, 0u);
+}

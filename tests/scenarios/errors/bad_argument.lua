@@ -1,0 +1,2 @@
+local w = asperity.world()
+w:add_particle({0, 0, 0}, "big")

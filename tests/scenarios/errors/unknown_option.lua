@@ -1,0 +1,1 @@
+local w = asperity.world{gravty = {0, 0, -9.81}}

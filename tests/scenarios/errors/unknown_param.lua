@@ -1,0 +1,1 @@
+local P = require("params").defaults{n = 10}

@@ -1,0 +1,1 @@
+local w = asperity.world{simd = "avx9000"}

@@ -1,0 +1,2 @@
+local w = asperity.world()
+w:run{steps = "many"}
