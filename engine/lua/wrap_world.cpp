@@ -652,6 +652,35 @@ int world_install_bonds(lua_State* L) {
   });
 }
 
+// Checkpoints: world:save(path), asperity.load(path [, {threads=, simd=}]).
+int world_save(lua_State* L) {
+  return guarded(L, [&] {
+    World& w = world_arg(L);
+    const char* path = luaL_checkstring(L, 2);
+    w.save(path);
+    return 0;
+  });
+}
+
+int l_load(lua_State* L) {
+  return guarded(L, [&] {
+    const std::string path = luaL_checkstring(L, 1);
+    int threads = 0;
+    std::string simd = "auto";
+    if (!lua_isnoneornil(L, 2)) {
+      Options o(L, 2, "asperity.load", 2);
+      threads = static_cast<int>(o.integer("threads", threads));
+      simd = o.string("simd", simd);
+      o.finish();
+    }
+    World loaded = World::load(path, threads, simd);
+    void* mem = lua_newuserdatauv(L, sizeof(World), 0);
+    new (mem) World(std::move(loaded));
+    luaL_setmetatable(L, kWorldType);
+    return 1;
+  });
+}
+
 int world_bond_count(lua_State* L) {
   return guarded(L, [&] {
     lua_pushinteger(L, static_cast<lua_Integer>(world_arg(L).bond_count()));
@@ -1202,6 +1231,8 @@ void open_world(lua_State* L) {
        "(default 1e-3 mean radius); beam_kn defaults to the world's kn, beam_ks to beam_kn/10;\n"
        "ids (a list or predicate) restricts them to pairs of those particles."},
       {"bond_count", world_bond_count, "world:bond_count() -> n", "Intact bonds."},
+      {"save", world_save, "world:save(path)",
+       "Writes a checkpoint (the whole state, HDF5); asperity.load(path) continues bit for bit."},
       {"bonds", world_bonds, "world:bonds() -> {bond, ...}",
        "Intact bonds: {a, b, normal, point, gap, beam_radius, normal_force, shear_force,\n"
        "twisting_moment, bending_moment, sigma, tau}."},
@@ -1257,6 +1288,8 @@ void open_world(lua_State* L) {
        "(auto), dt = 0 (auto), dt_safety = 0.8, allow_dt_above_estimate = false,\n"
        "dt_interval = 100, threads = 0 (all), simd = \"auto\" (scalar, sse4_2, avx2, avx512f),\n"
        "track_energy = true, reorder_interval = 10, lock_bonded_rotation = true."},
+      {"load", l_load, "asperity.load(path [, {threads=, simd=}]) -> World",
+       "A world from a checkpoint written by world:save(path)."},
       {"bond_criterion", l_bond_criterion, "asperity.bond_criterion(sigma, tau, tensile_strength) -> f",
        "The elliptic strength criterion [3-46..3-49]: >= 1 means the bond fails."},
   };

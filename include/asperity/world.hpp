@@ -272,6 +272,12 @@ class World {
   std::vector<ContactInfo> contacts() const;  // touching ball-ball pairs
   std::size_t contact_count() const;
 
+  // --- checkpoints ---------------------------------------------------------------------------
+  // The whole state in one HDF5 file (written to a temporary name, then renamed); a world loaded
+  // from it continues bit for bit as the saved one would have.
+  void save(const std::string& path) const;
+  static World load(const std::string& path, int threads = 0, const std::string& simd = "auto");
+
   // Internal state, for the engine's own tests and the Lua layer's bulk access.
   detail::State& state() { return *state_; }
   const detail::State& state() const { return *state_; }

@@ -1,0 +1,74 @@
+// Checkpoints: a run restarted from a checkpoint continues bit for bit.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+
+#include "scenes.hpp"
+
+using namespace asperity;
+
+namespace {
+std::string temp_file(const char* name) {
+  return (std::filesystem::temp_directory_path() / name).string();
+}
+
+bool same(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+}  // namespace
+
+TEST(Checkpoint, RestartContinuesBitForBit) {
+  // A busy scene: falling particles in a box, then bonded, a mesh wall, a servo platen.
+  WorldSettings ws;
+  ws.dt = 5e-4;
+  World w = test::random_box(400, ws);
+  std::vector<Vec3> v{{0, 0, 1e-3}, {0.012, 0, 1e-3}, {0, 0.012, 1e-3}, {0.012, 0.012, 1e-3}};
+  std::vector<std::array<int, 3>> t{{0, 1, 3}, {0, 3, 2}};
+  w.add_mesh(v, t);
+  w.cycle(1500);
+  BondMaterial bm;
+  bm.tensile_strength = 0.02;
+  w.install_bonds(bm, 2e-5);
+  std::vector<std::int64_t> top;
+  for (std::int64_t id = 0; id < 20; ++id) top.push_back(id);
+  GroupMotion m;
+  m.translation = {Dof::fixed, Dof::velocity, Dof::servo};
+  m.velocity = {0, 1e-4, 0};
+  m.servo[2].target_force = 1e-6;
+  w.add_group(top, m);
+  w.cycle(500);
+  const std::string path = temp_file("asperity_checkpoint_test.h5");
+  w.save(path);
+  w.cycle(700);
+
+  World r = World::load(path, 1, "scalar");
+  EXPECT_EQ(r.step_count() + 700, w.step_count());
+  r.cycle(700);
+  EXPECT_TRUE(same(w.positions(), r.positions()));
+  EXPECT_TRUE(same(w.velocities(), r.velocities()));
+  EXPECT_TRUE(same(w.forces(), r.forces()));
+  EXPECT_EQ(w.bond_count(), r.bond_count());
+  EXPECT_EQ(w.break_events().size(), r.break_events().size());
+  EXPECT_GT(w.bond_count(), 0u) << "the scene must hold bonds";
+  EXPECT_GT(w.break_events().size(), 0u) << "and break some of them";
+  const Energies a = w.energies(), b = r.energies();
+  EXPECT_EQ(a.friction, b.friction);
+  EXPECT_EQ(a.boundary_work, b.boundary_work);
+  EXPECT_EQ(a.released, b.released);
+  EXPECT_EQ(w.group_position(0), r.group_position(0));
+  std::filesystem::remove(path);
+}
+
+TEST(Checkpoint, MissingOrForeignFileIsAClearError) {
+  EXPECT_THROW(World::load("/nonexistent/x.h5"), Error);
+  const std::string path = temp_file("asperity_not_a_checkpoint.txt");
+  { std::FILE* f = std::fopen(path.c_str(), "w"); std::fputs("hello", f); std::fclose(f); }
+  try {
+    World::load(path);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("not an HDF5 file"), std::string::npos);
+  }
+  std::filesystem::remove(path);
+}
