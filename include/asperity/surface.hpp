@@ -371,6 +371,117 @@ struct ProfileSummary {
 ProfileSummary analyze(const Profile& profile, const AnalysisOptions& options = {});
 
 // ------------------------------------------------------------------------------------------------
+// From a synthetic surface to a DEM surface (spec section 3, thesis 3.4.1;
+// engine/surface/dem_surface.cpp)
+
+// Which half of a joint the particles form: the profilometer reads the top of the lower half
+// (highest particle point over each node) and the bottom of the upper half (lowest point).
+enum class HalfSide { lower, upper };
+
+// The profilometer's grid: node (i, j) is at (x0 + i spacing, y0 + j spacing) in the particles'
+// frame. Usually the synthetic map's grid (same nx, ny, spacing) placed where the mold was.
+struct ProfilometerGrid {
+    int nx = 0, ny = 0;
+    double spacing = 0.0;     // m
+    double x0 = 0.0, y0 = 0.0;  // m
+};
+
+struct ProfilometerResult {
+    HeightMap surface;                   // z_dem per node (m); NaN where no particle covers it
+    std::vector<std::int64_t> particle;  // per node: the particle giving the height, -1 if none
+    std::size_t covered = 0;             // nodes with a height
+    std::size_t particles = 0;           // distinct particles giving at least one node
+};
+
+// Numerical profilometer: for each node the highest (lower half) or lowest (upper half) point
+// of the spheres whose disc covers it, zc +- sqrt(R^2 - (x - xc)^2 - (y - yc)^2).
+// positions: x0, y0, z0, x1, ... (3 N values), radii: N values. `subset` (indices into them)
+// restricts the particles considered; empty means all. Particle numbers in the result are
+// indices into positions/radii. Cost O(N (2R/h + 1)^2 + nx ny): each sphere visits only the
+// nodes of its disc's bounding box.
+ProfilometerResult profilometer(std::span<const double> positions, std::span<const double> radii,
+                                const ProfilometerGrid& grid, HalfSide side,
+                                std::span<const std::int64_t> subset = {});
+
+// Mean plane of a DEM surface by the modified Abbott curve: the synthetic surface shifted by dv
+// has reached the DEM surface at the nodes where z_syn + dv >= z_dem, so the share of such nodes
+// as a function of dv is the cumulative distribution F(dv) of d = z_dem - z_syn. The DEM mean
+// plane is the synthetic one shifted by dv_mp, the dv of steepest F (the mode of d), where most
+// nodes of the DEM surface lie on the synthetic surface.
+struct DemMeanPlaneOptions {
+    int levels = 401;         // points of the returned curves, evenly spaced over [min d, max d]
+    double bandwidth = 0.0;   // m, Gaussian kernel for dF/ddv; <= 0: Silverman's rule (see .cpp)
+    double tolerance = 0.0;   // m, |d - dv_mp| <= tolerance counts as coinciding; <= 0: 1 % of
+                              // the synthetic surface's rms height
+};
+struct DemMeanPlane {
+    double shift = 0.0;                // dv_mp (m)
+    double coinciding_fraction = 0.0;  // share of covered nodes with |d - dv_mp| <= tolerance
+    double tolerance = 0.0;            // m, as used
+    double bandwidth = 0.0;            // m, as used
+    double mean_difference = 0.0;      // <d> (m): what a plain mean would give (biased by holes)
+    std::size_t points = 0;            // nodes with a finite z_dem
+    std::vector<double> dv;            // m, increasing
+    std::vector<double> cumulative;    // F(dv): share of nodes with z_syn + dv >= z_dem
+    std::vector<double> density;       // dF/ddv (1/m), kernel-smoothed
+};
+// dem and synthetic on the same grid (nx, ny); NaN heights of dem (uncovered nodes) are skipped.
+DemMeanPlane dem_mean_plane(const HeightMap& dem, const HeightMap& synthetic,
+                            const DemMeanPlaneOptions& options = {});
+
+// Surface vs porosity particles [3-52..3-54]: a profilometer particle belongs to the rough
+// surface when at least one of the nodes it gives satisfies |z_dem - (z_syn + shift)| <= band,
+// i.e. it touches the expected surface somewhere; the others are porosity particles, seen by the
+// profilometer through holes of the packing below (lower half) or above (upper half) it.
+struct SurfaceParticles {
+    std::vector<std::int64_t> surface;   // particle numbers (as in ProfilometerResult), sorted
+    std::vector<std::int64_t> porosity;  // sorted
+    double retained_fraction = 0.0;      // surface / (surface + porosity)
+    double node_fraction = 0.0;          // share of covered nodes within the band
+    double band = 0.0;                   // m
+    double shift = 0.0;                  // m
+};
+SurfaceParticles classify_surface_particles(const HeightMap& dem,
+                                            std::span<const std::int64_t> node_particle,
+                                            const HeightMap& synthetic, double shift, double band);
+inline SurfaceParticles classify_surface_particles(const ProfilometerResult& profile,
+                                                   const HeightMap& synthetic, double shift,
+                                                   double band) {
+    return classify_surface_particles(profile.surface, profile.particle, synthetic, shift, band);
+}
+
+// Noise study: uncorrelated Gaussian noise of standard deviation level * rms(map) added to the
+// map (one noise field of the seed, scaled per level), then H and s2 re-measured with the fit
+// windows of the clean map, so only the surface changes between levels, not the estimator.
+struct NoiseLevel {
+    double level = 0.0;          // noise rms / height rms
+    double noise_rms = 0.0;      // m
+    double variance = 0.0;       // m^2, of the noisy map about its mean plane
+    double hurst_psd = 0.0;
+    double hurst_structure = 0.0;
+    double psd_fit_r2 = 0.0;     // r^2 of the log-log PSD fit: how well a power law still holds
+    double structure_fit_r2 = 0.0;
+    double correlation_length = 0.0;  // m
+};
+std::vector<NoiseLevel> noise_study(const HeightMap& map, std::span<const double> levels,
+                                    std::uint64_t seed = 1, const AnalysisOptions& options = {});
+
+// ------------------------------------------------------------------------------------------------
+// Elevation map plot (engine/surface/plot_map.cpp)
+
+struct MapPlotOptions {
+    std::string title;
+    int width = 900, height = 800;  // pixels
+    double length_scale = 1e3;      // axis values = metres * length_scale (mm by default)
+    double height_scale = 1e3;      // colour values = metres * height_scale
+    std::string length_unit = "mm", height_unit = "mm";
+};
+// Heat map of the heights (gnuplot, `with image`), drawn to a temporary name and renamed.
+// NaN nodes are left blank. Throws Error when gnuplot is missing or fails.
+void plot_height_map_png(const HeightMap& map, const std::string& path,
+                         const MapPlotOptions& options = {});
+
+// ------------------------------------------------------------------------------------------------
 // Files (engine/surface/surface_io.cpp)
 
 // HDF5: dataset `height` (ny x nx doubles, m, row = y index) with attributes `spacing` (m),
