@@ -472,6 +472,7 @@ int open_asperity(lua_State* L) {
   open_series(L);
   open_snapshots(L);
   open_io(L);
+  open_surface(L);
   return 1;
 }
 

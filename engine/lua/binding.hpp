@@ -144,6 +144,7 @@ void open_world(lua_State* L);
 void open_series(lua_State* L);
 void open_snapshots(lua_State* L);
 void open_io(lua_State* L);
+void open_surface(lua_State* L);  // asperity.surface (wrap_surface.cpp)
 
 // The `asperity` module table, complete (pushed).
 int open_asperity(lua_State* L);

@@ -165,7 +165,7 @@ int open_all(lua_State* L) {
   lua_pushvalue(L, module);
   lua_getfield(L, module, "doc");
   lua_newtable(L);
-  for (const char* type : {"asperity.World", "asperity.Array", "asperity.Series", "asperity.Snapshots", "asperity.vec"}) {
+  for (const char* type : {"asperity.World", "asperity.Array", "asperity.Series", "asperity.Snapshots", "asperity.vec", "asperity.HeightMap"}) {
     luaL_getmetatable(L, type);
     lua_getfield(L, -1, "methods");
     lua_setfield(L, -3, type + std::strlen("asperity."));
