@@ -635,6 +635,22 @@ std::size_t World::install_bonds(const BondMaterial& material, double tolerance,
 
 std::size_t World::bond_count() const { return state_->bonds.n; }
 
+void World::set_bond_strength(double tensile_strength, bool breakable) {
+  require(!breakable || (tensile_strength > 0 && std::isfinite(tensile_strength)),
+          "set_bond_strength: a breakable bond needs tensile_strength > 0 (Pa), got " +
+              num(tensile_strength));
+  state_->bonds.material.tensile_strength = breakable ? tensile_strength : 0.0;
+  state_->bonds.material.breakable = breakable;
+}
+
+void World::remove_bonds() {
+  State& s = *state_;
+  s.bonds.resize(0);
+  detail::refresh_bond_topology(s);
+  touch(s);  // the freed pairs enter the contact list at the next rebuild
+  s.reference_energy = -1;
+}
+
 double World::bond_criterion(double sigma, double tau, double tensile_strength) {
   return kernels::elliptic_criterion(sigma, tau, tensile_strength);
 }

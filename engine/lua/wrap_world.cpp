@@ -681,6 +681,27 @@ int l_load(lua_State* L) {
   });
 }
 
+int world_set_bond_strength(lua_State* L) {
+  return guarded(L, [&] {
+    World& w = world_arg(L);
+    Options o(L, 2, "world:set_bond_strength", 2);
+    const bool breakable = o.boolean("breakable", true);
+    const auto st = o.number("tensile_strength");
+    o.finish();
+    if (breakable && !st)
+      throw Error("world:set_bond_strength: give tensile_strength = (Pa), or breakable = false");
+    w.set_bond_strength(st ? *st : 0.0, breakable);
+    return 0;
+  });
+}
+
+int world_remove_bonds(lua_State* L) {
+  return guarded(L, [&] {
+    world_arg(L).remove_bonds();
+    return 0;
+  });
+}
+
 int world_bond_count(lua_State* L) {
   return guarded(L, [&] {
     lua_pushinteger(L, static_cast<lua_Integer>(world_arg(L).bond_count()));
@@ -1231,6 +1252,11 @@ void open_world(lua_State* L) {
        "(default 1e-3 mean radius); beam_kn defaults to the world's kn, beam_ks to beam_kn/10;\n"
        "ids (a list or predicate) restricts them to pairs of those particles."},
       {"bond_count", world_bond_count, "world:bond_count() -> n", "Intact bonds."},
+      {"set_bond_strength", world_set_bond_strength,
+       "world:set_bond_strength{tensile_strength= | breakable=false}",
+       "Changes the strength of every bond (stiffness and stored forces unchanged)."},
+      {"remove_bonds", world_remove_bonds, "world:remove_bonds()",
+       "Deletes every bond (no break events; bonded pairs become ordinary contacts)."},
       {"save", world_save, "world:save(path)",
        "Writes a checkpoint (the whole state, HDF5); asperity.load(path) continues bit for bit."},
       {"bonds", world_bonds, "world:bonds() -> {bond, ...}",

@@ -285,7 +285,11 @@ void build_pairs(State& s, const CellGrid& g) {
     if (o < old.n && old.a[o] == a && old.b[o] == b) {
       fresh.nx[k] = old.nx[o]; fresh.ny[k] = old.ny[o]; fresh.nz[k] = old.nz[o];
       fresh.fsx[k] = old.fsx[o]; fresh.fsy[k] = old.fsy[o]; fresh.fsz[k] = old.fsz[o];
-      fresh.fn[k] = old.fn[o]; fresh.overlap[k] = old.overlap[o];
+      fresh.fn[k] = old.fn[o];
+      // The overlap as it is now (radii may have changed since the last step): the time-step
+      // estimate made right after this rebuild counts the contacts of the current geometry.
+      const double dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];
+      fresh.overlap[k] = p.radius[a] + p.radius[b] - std::sqrt(dx * dx + dy * dy + dz * dz);
     } else {
       // New pair: no shear force; its "previous normal" is the current direction.
       const double dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];

@@ -245,6 +245,10 @@ class World {
   std::size_t install_bonds(const BondMaterial& material, double tolerance = -1,
                             std::span<const std::int64_t> ids = {});
   std::size_t bond_count() const;                   // intact bonds
+  // Change the strength of every bond (e.g. unbreakable while a specimen is prepared, then the
+  // calibrated strength for the fracture model). Stiffness and stored forces are unchanged.
+  void set_bond_strength(double tensile_strength, bool breakable);
+  void remove_bonds();                              // all of them (no events, no energy booked)
   std::vector<BondInfo> bonds() const;
   const std::vector<BreakEvent>& break_events() const;
   // Sigma and tau [3-27] of every intact bond, and the elliptic criterion's value (>= 1: fails).
