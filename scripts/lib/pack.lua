@@ -9,6 +9,22 @@
 -- in radius * [1 - spread, 1 + spread]. Each centre is shifted at random by up to the free room
 -- (jitter = true, the default) so the particles do not stand in columns when they fall.
 -- All added in one bulk call.
+--
+--   local r = require("radii").truncated_gaussian{count = 935, mean = 0.5e-3, sd = 0.1e-3, seed = 1}
+--   local box = require("walls").box(world, {min = {0,0,0}, max = {0.01,0.01,0.01}})
+--   local res = pack.expand(world, {min = {0,0,0}, max = {0.01,0.01,0.01}, radii = r, seed = 1,
+--                                   walls = box})
+--
+-- expand: radius-expansion packing [thesis 3.3; scenarios.md 1]. The centres are placed at random
+-- in the region (the box min..max, cut by `inside(x, y, z, r)` if given, e.g. the side of a mould),
+-- not overlapping one another at the initial radii (the final ones times initial_scale, 1/10);
+-- then the radii grow in `stages` (40) equal factors, cycling `stage_steps` (250) steps after each
+-- (small steps: a light particle squeezed by a large growth step is shot away); then
+-- the assembly cycles until the unbalanced-force ratio (mean unbalanced / mean contact force,
+-- PFC's) is below `ratio` (1e-4). The region must be closed by walls the caller made. Returns
+-- {first, last, steps, ratio, seconds, porosity_nominal, porosity_true, mean_radius, contacts,
+-- coordination, wall_stress (with `walls` from walls.box: name -> Pa, compression positive)}.
+-- The porosities refer to the box volume unless `volume` is given (a region cut by a mould).
 local M = {}
 
 function M.grid(world, o)
@@ -47,6 +63,205 @@ function M.grid(world, o)
     end
   end
   return world:add_particles(xyz, radii, o.density)
+end
+
+local function box_volume(lo, hi) return (hi[1] - lo[1]) * (hi[2] - lo[2]) * (hi[3] - lo[3]) end
+
+-- Random centres for `radii` (already scaled) in the box lo..hi, accepted by inside(x, y, z, r),
+-- without overlaps among themselves (a hash grid keeps it linear).
+local function place(radii, lo, hi, inside, rng, attempts)
+  local rmax = 0
+  for i = 1, #radii do rmax = math.max(rmax, radii[i]) end
+  local cell = 2 * rmax
+  local grid, xyz = {}, {}
+  local function key(i, j, k) return (i * 4096 + j) * 4096 + k end
+  for n = 1, #radii do
+    local r = radii[n]
+    local placed = false
+    for _ = 1, attempts do
+      local x = rng:uniform(lo[1] + r, hi[1] - r)
+      local y = rng:uniform(lo[2] + r, hi[2] - r)
+      local z = rng:uniform(lo[3] + r, hi[3] - r)
+      if not inside or inside(x, y, z, r) then
+        local ci, cj, ck = (x - lo[1]) // cell, (y - lo[2]) // cell, (z - lo[3]) // cell
+        local free = true
+        for di = -1, 1 do
+          for dj = -1, 1 do
+            for dk = -1, 1 do
+              local list = grid[key(ci + di, cj + dj, ck + dk)]
+              if list then
+                for _, m in ipairs(list) do
+                  local dx, dy, dz = xyz[3 * m - 2] - x, xyz[3 * m - 1] - y, xyz[3 * m] - z
+                  if dx * dx + dy * dy + dz * dz < (radii[m] + r) ^ 2 then free = false break end
+                end
+              end
+              if not free then break end
+            end
+            if not free then break end
+          end
+          if not free then break end
+        end
+        if free then
+          xyz[3 * n - 2], xyz[3 * n - 1], xyz[3 * n] = x, y, z
+          local k = key(ci, cj, ck)
+          grid[k] = grid[k] or {}
+          table.insert(grid[k], n)
+          placed = true
+          break
+        end
+      end
+    end
+    if not placed then
+      error(("pack.expand: no room for particle %d of %d after %d attempts (region too small or initial_scale too large)"):format(n, #radii, attempts), 3)
+    end
+  end
+  return xyz
+end
+
+-- Stresses on the walls of walls.box (name -> Pa, compression positive): |force . normal| / area.
+function M.box_wall_stresses(world, box, lo, hi)
+  local L = {hi[1] - lo[1], hi[2] - lo[2], hi[3] - lo[3]}
+  local area = {x_min = L[2] * L[3], x_max = L[2] * L[3], y_min = L[1] * L[3], y_max = L[1] * L[3],
+                bottom = L[1] * L[2], top = L[1] * L[2]}
+  local axis = {x_min = "x", x_max = "x", y_min = "y", y_max = "y", bottom = "z", top = "z"}
+  local out = {}
+  for name, id in pairs(box) do
+    if area[name] then out[name] = math.abs(world:wall_force(id)[axis[name]]) / area[name] end
+  end
+  return out
+end
+
+-- After radii change, the engine's time-step estimate at the next neighbour rebuild still counts
+-- the contacts (overlaps) of the old radii, so a sudden growth that creates many new contacts runs
+-- for up to dt_interval steps above the critical step. One step computes the new overlaps;
+-- set_dt(0) then forces a fresh estimate before the next one.
+function M.refresh_dt(world)
+  world:cycle(1)
+  if world:settings().dt == 0 then world:set_dt(0) end
+end
+
+function M.expand(world, o)
+  local known = {min = true, max = true, inside = true, radii = true, seed = true, rng = true,
+                 initial_scale = true, stages = true, stage_steps = true, ratio = true,
+                 max_steps = true, walls = true, volume = true, density = true, attempts = true,
+                 progress = true}
+  for k in pairs(o) do
+    if not known[k] then error("pack.expand: unknown option '" .. tostring(k) .. "'", 2) end
+  end
+  assert(o.min and o.max and o.radii, "pack.expand: min, max and radii are required")
+  local t0 = asperity.wall_time()
+  local rng = o.rng or require("random").new(o.seed or 1)
+  local s0 = o.initial_scale or 0.1
+  local stages = o.stages or 40
+  local final = o.radii
+  local small = {}
+  for i = 1, #final do small[i] = final[i] * s0 end
+  local xyz = place(small, o.min, o.max, o.inside, rng, o.attempts or 1000)
+  local before = world:particle_count()
+  local first, last = world:add_particles(xyz, small, o.density)
+  local alone = before == 0   -- the world holds only these particles: scale_radii does it at once
+  local steps = 0
+  local factor = (1 / s0) ^ (1 / stages)
+  for stage = 1, stages do
+    local scale = s0 * factor ^ stage
+    if stage == stages then scale = 1 end
+    if alone then
+      world:scale_radii(scale / (s0 * factor ^ (stage - 1)))
+    end
+    -- set every radius exactly (no drift from repeated products)
+    for i = 1, #final do world:set_radius(first + i - 1, final[i] * scale) end
+    M.refresh_dt(world)
+    steps = steps + 1 + world:cycle((o.stage_steps or 250) - 1)
+  end
+  -- Below jamming the particles end without contacts: no ratio (infinite), stop there too.
+  local why = "steps"
+  local n = world:run{steps = o.max_steps or 1000000, every = 100, progress = o.progress,
+    stop_when = function(w)
+      if w:unbalanced_force_ratio() <= (o.ratio or 1e-4) then why = "equilibrium" return true end
+      if w:contact_count() == 0 and w:stats().wall_contacts == 0 then why = "no contacts" return true end
+    end}
+  steps = steps + n
+  local volume = o.volume or box_volume(o.min, o.max)
+  local rtab = {}
+  for i = 1, #final do rtab[i] = final[i] end
+  local nominal, true_n, mean = require("radii").porosity(rtab, volume)
+  local contacts = world:contact_count()
+  local res = {first = first, last = last, count = #final, steps = steps, reached = why == "equilibrium",
+               jammed = why ~= "no contacts",
+               ratio = world:unbalanced_force_ratio(), seconds = asperity.wall_time() - t0,
+               porosity_nominal = nominal, porosity_true = true_n, mean_radius = mean,
+               contacts = contacts, coordination = 2 * contacts / #final}
+  if o.walls then res.wall_stress = M.box_wall_stresses(world, o.walls, o.min, o.max) end
+  return res
+end
+
+-- Multiply the radii of particles first..last by `factor` (all at once with scale_radii when they are
+-- the whole world, which also re-derives the neighbour skin), then refresh the time step.
+function M.scale(world, first, last, factor)
+  if first == 1 and last == world:particle_count() then
+    world:scale_radii(factor)
+  else
+    for id = first, last do world:set_radius(id, world:radius(id) * factor) end
+  end
+  M.refresh_dt(world)
+end
+
+local function mean_stress(world, box, lo, hi)
+  local s, n = 0, 0
+  for _, v in pairs(M.box_wall_stresses(world, box, lo, hi)) do s, n = s + v, n + 1 end
+  return s / n
+end
+
+-- Isotropic stress installation (as in PFC's bonded-particle genesis, Potyondy & Cundall 2004):
+-- after the expansion, scale the radii of first..last by a common factor until the mean stress on
+-- the box walls is `target` (Pa) within `tolerance` (relative), cycling to equilibrium after each
+-- change. A packing just above jamming carries a stress that is very sensitive to its density (a
+-- radius change of 0.4 % takes a 1 cm REV from 0.3 Pa to nothing), and the expansion may end on
+-- either side; so the factor is first bracketed (steps growing from `step`, 0.1 %) and then found
+-- by bisection. The stress locked into the packing becomes internal bond stress when the walls go.
+-- Returns {factor, stress, iterations, steps, reached}; the porosity changes by factor^3.
+function M.install_stress(world, o)
+  local known = {first = true, last = true, walls = true, min = true, max = true, target = true,
+                 tolerance = true, ratio = true, max_steps = true, iterations = true, step = true}
+  for k in pairs(o) do
+    if not known[k] then error("pack.install_stress: unknown option '" .. tostring(k) .. "'", 2) end
+  end
+  local lo, hi, box = o.min, o.max, o.walls
+  local target, tol = o.target, o.tolerance or 0.2
+  local steps, iterations = 0, 0
+  local f_now = 1
+  local function stress_at(f)
+    if f ~= f_now then
+      M.scale(world, o.first, o.last, f / f_now)
+      f_now = f
+    end
+    -- A packing without contacts has no equilibrium ratio (infinite): stop there too.
+    local n = world:run{steps = o.max_steps or 200000, every = 100, stop_when = function(w)
+      return w:unbalanced_force_ratio() <= (o.ratio or 1e-4) or
+             (w:contact_count() == 0 and w:stats().wall_contacts == 0)
+    end}
+    steps = steps + n
+    iterations = iterations + 1
+    return mean_stress(world, box, lo, hi)
+  end
+  local function good(p) return math.abs(p - target) <= tol * target end
+  local p = stress_at(1)
+  local f_lo, f_hi   -- stress below / above the target
+  local step = o.step or 1e-3
+  if p > target then f_hi = 1 else f_lo = 1 end
+  local max_it = o.iterations or 30
+  while not good(p) and not (f_lo and f_hi) and iterations < max_it do   -- bracket
+    local f = f_lo and not f_hi and f_lo * (1 + step) or f_hi * (1 - step)
+    step = step * 2
+    p = stress_at(f)
+    if p > target then f_hi = f else f_lo = f end
+  end
+  while not good(p) and iterations < max_it and f_hi - f_lo > 1e-6 do   -- bisection
+    local f = 0.5 * (f_lo + f_hi)
+    p = stress_at(f)
+    if p > target then f_hi = f else f_lo = f end
+  end
+  return {factor = f_now, stress = p, iterations = iterations, steps = steps, reached = good(p)}
 end
 
 return M

@@ -7,8 +7,10 @@
 #include <numbers>
 
 #include "asperity/world.hpp"
+#include "core/report.hpp"
 
 using namespace asperity;
+using asperity::test::report;
 
 namespace {
 struct CollisionResult {
@@ -50,6 +52,8 @@ TEST(Collision, DurationAndReboundMatchTheLinearSpring) {
   const auto r = collide(speed, {1, 0, 0}, true);
   const double m = 2500 * 4.0 / 3.0 * std::numbers::pi * std::pow(5e-4, 3);
   const double expected = std::numbers::pi * std::sqrt(m / 2 / 0.1);
+  report("contact duration [s] vs pi sqrt(m_eff/kn)", r.duration, expected);
+  report("rebound speed / impact speed", r.rebound_speed / speed, 1.0);
   EXPECT_NEAR(r.duration, expected, r.dt) << "contact duration vs pi sqrt(m_eff/kn)";
   EXPECT_NEAR(r.rebound_speed / speed, 1.0, 1e-4) << "rebound speed / impact speed";
 }

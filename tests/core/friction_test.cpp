@@ -6,8 +6,10 @@
 #include <cmath>
 
 #include "asperity/world.hpp"
+#include "core/report.hpp"
 
 using namespace asperity;
+using asperity::test::report;
 
 namespace {
 constexpr double kR = 5e-4, kN = 1e-5, kMu = 0.5;
@@ -33,6 +35,7 @@ TEST(Friction, SticksBelowTheCoulombLimit) {
   std::int64_t id;
   World w = sphere_on_plane(T, 0.7, id);
   w.cycle(40000);
+  report("stick at T = 0.6 mu N: displacement [m] vs T/ks", w.position(id).x, T / 0.01);
   EXPECT_NEAR(w.position(id).x, T / 0.01, 1e-6 * T / 0.01) << "held by the shear spring at T/ks";
   EXPECT_NEAR(w.velocity(id).x, 0.0, 1e-9);
   EXPECT_NEAR(w.wall_force(0).x, T, 1e-9 * T) << "the plane holds the full tangential force";
@@ -49,6 +52,8 @@ TEST(Friction, SlidesAboveTheCoulombLimit) {
   const double v2 = w.velocity(id).x, t2 = w.time();
   EXPECT_NEAR(w.wall_force(0).x, kMu * kN, 1e-12 * kMu * kN) << "shear force capped at mu N";
   const double accel = (T - kMu * kN) / w.mass(id);
+  report("slide at T = 1.5 mu N: wall shear force [N] vs mu N", w.wall_force(0).x, kMu * kN);
+  report("slide at T = 1.5 mu N: acceleration [m/s^2] vs (T - mu N)/m", (v2 - v1) / (t2 - t1), accel);
   EXPECT_NEAR((v2 - v1) / (t2 - t1), accel, 1e-6 * accel);
   EXPECT_GT(w.energies().friction, 0.0);
 }

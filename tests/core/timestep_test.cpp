@@ -12,8 +12,10 @@
 #include <random>
 
 #include "asperity/world.hpp"
+#include "core/report.hpp"
 
 using namespace asperity;
+using asperity::test::report;
 
 namespace {
 World chain(int n, bool allow) {
@@ -57,6 +59,7 @@ TEST(TimeStep, ChainRunsStablyAtNinetyFivePercent) {
   const Energies e0 = w.energies();
   EXPECT_NO_THROW(w.cycle(50000));
   const Energies e = w.energies();
+  report("chain at 0.95 x estimate, (Ek+Es) after 5e4 steps / start", (e.kinetic + e.strain) / (e0.kinetic + e0.strain), 1.0);
   EXPECT_NEAR((e.kinetic + e.strain) / (e0.kinetic + e0.strain), 1.0, 0.05);
 }
 
@@ -90,6 +93,7 @@ TEST(TimeStep, BeyondTheTrueLimitTheBlowUpIsDetected) {
     detected_at = e.step;
     EXPECT_GE(e.particle_id >= 0 || e.quantity == "kinetic + strain energy", true);
   }
+  report("chain at 1.6 x estimate (fixed dt allowed): step at which the blow-up is detected", detected_at, 0);
   EXPECT_GT(detected_at, 0u) << "the runaway must be detected";
   EXPECT_LT(detected_at, 2000u);
 }
@@ -120,6 +124,9 @@ TEST(TimeStep, DampingRatioOfOneDegreeOfFreedom) {
     }
     ASSERT_GE(extrema.size(), 3u);
     const double expected = std::sqrt((1 - alpha) / (1 + alpha));
+    char what[96];
+    std::snprintf(what, sizeof what, "alpha %.1f: first extremum ratio vs sqrt((1-a)/(1+a))", alpha);
+    report(what, std::fabs(extrema[1] / extrema[0]), expected);
     for (std::size_t k = 1; k < extrema.size(); ++k)
       EXPECT_NEAR(std::fabs(extrema[k] / extrema[k - 1]), expected, 2e-3)
           << "alpha " << alpha << " extremum " << k;

@@ -1,0 +1,508 @@
+-- A rock joint closed and sheared under constant normal load (scenarios.md 3-6, surfaces.md 3).
+--
+--   build/asperity run scripts/joint.lua                              -- the default small joint
+--   build/asperity run scripts/joint.lua surface=S5 model=fracture stress=21 direction=y
+--   build/asperity run scripts/joint.lua scale=thesis                 -- 10 cm x 10 cm
+--
+-- Steps: generate (or load) the surface; mould it as a triangle mesh between two boxes of plane
+-- walls; pack both halves at once by radius expansion (the mould separates them); bond each half
+-- (unbreakable while prepared); remove the walls, part the halves by `gap` and relax them; cache
+-- the result on disk (keyed by everything that shaped it, so the three models and both
+-- directions reuse it); analyse the DEM surfaces (profilometer, mean plane, surface vs porosity
+-- particles); then, for the chosen model, bring the halves together until one contact exists,
+-- close the joint at 6e-5 m/s to the normal stress, and shear it under constant normal load.
+--
+-- Models [scenarios.md 4]: rigid (each half one rigid body; only particles that can touch the
+-- other half are searched), elastic (unbreakable bonds), fracture (elliptic criterion with the
+-- calibrated bond strength). Stresses are reported in model units and scaled to rock [3-37].
+--
+-- Writes into `out`: summary.json; closure.{h5,csv}, shear.{h5,csv}; snapshots (HDF5 + XDMF) at
+-- the displacements in `snapshots`; PNG plots: shear stress and dilatancy, closure curve, contact
+-- count, broken bonds, energies, and maps of contact points and broken bonds over the elevation.
+local mat = require("materials")
+local radii_lib = require("radii")
+local pack = require("pack")
+local heightmap = require("heightmap")
+
+local P = require("params").defaults{
+  surface = "S1",          -- S1..S8 (scenarios / surfaces.md table 4)
+  surface_file = "",       -- or an HDF5 height map (dataset `height`, attribute `spacing`)
+  scale = "",              -- "thesis": size 0.1 m (about 110 000 particles)
+  size = 0.02,             -- side of the square joint, m
+  thickness = 0.006,       -- each half beyond the mean plane, m
+  spacing = 0.1 / 365,     -- surface grid spacing, m (the thesis grid)
+  model = "elastic",       -- rigid | elastic | fracture
+  stress = 14,             -- normal stress, MPa (scaled)
+  direction = "x",         -- x | y: the upper half moves along -x or -y
+  shear = 5,               -- shear displacement, mm
+  velocity = 3e-5,         -- shear velocity, m/s
+  normal_control = "load", -- load: constant applied force on a free platen (dead load); servo
+  closure_velocity = 6e-5, -- m/s [thesis 4.2.2]
+  approach_velocity = 1e-3,-- m/s, until the first contact between the halves
+  gap = 1e-3,              -- m, between the halves while they relax
+  platen = 1.5e-3,         -- m, layer of each outer face that forms a platen
+  porosity = 0.51,
+  seed = 1,
+  record = 0.01,           -- mm of shear between records
+  snapshots = "0,1,2.5,5", -- mm of shear
+  band = 0,                -- surface vs porosity band, m (0: mean radius)
+  out = "out/joint",
+  cache = "out/cache",
+  threads = 0,
+  progress = true,
+}
+if P.scale == "thesis" then
+  if params.size == nil then P.size = 0.1 end
+elseif P.scale ~= "" then
+  error("scale must be \"thesis\" or empty, got '" .. P.scale .. "'")
+end
+local models = {rigid = true, elastic = true, fracture = true}
+if not models[P.model] then error("model must be rigid, elastic or fracture, got '" .. P.model .. "'") end
+if P.direction ~= "x" and P.direction ~= "y" then error("direction must be x or y") end
+local t_start = asperity.wall_time()
+asperity.mkdir(P.out)
+asperity.mkdir(P.cache)
+local function log(fmt, ...) io.stderr:write(("[joint] " .. fmt .. "\n"):format(...)) end
+
+-- 1. The surface ---------------------------------------------------------------------------
+local n = 2 * math.floor(P.size / P.spacing / 2) + 1     -- odd grid
+local map
+if P.surface_file ~= "" then
+  map = asperity.surface.load(P.surface_file)
+else
+  map = asperity.surface.generate{name = P.surface, n = n, side = n * P.spacing, seed = P.seed}
+end
+local nx, ny = map:size()
+local h = map:spacing()
+local Lx, Ly = (nx - 1) * h, (ny - 1) * h                 -- the mesh spans (n - 1) spacings
+local heights = {}
+for j = 1, ny do for i = 1, nx do heights[#heights + 1] = map:at(i, j) end end
+local function surface_z(x, y)                             -- the mould, bilinear in each cell
+  local fi, fj = x / h, y / h
+  local i, j = math.max(0, math.min(nx - 2, math.floor(fi))), math.max(0, math.min(ny - 2, math.floor(fj)))
+  local u, v = fi - i, fj - j
+  local function z(a, b) return heights[(j + b) * nx + (i + a) + 1] end
+  return (1 - u) * (1 - v) * z(0, 0) + u * (1 - v) * z(1, 0) + (1 - u) * v * z(0, 1) + u * v * z(1, 1)
+end
+local zmin, zmax = math.huge, -math.huge
+for _, z in ipairs(heights) do zmin, zmax = math.min(zmin, z), math.max(zmax, z) end
+local T = P.thickness
+
+-- 2. The specimen: packed, bonded, relaxed halves (cached) ---------------------------------
+local key = ("%s_%s_n%d_h%.6g_T%.6g_p%.4g_s%d_g%.6g"):format(
+  P.surface_file ~= "" and P.surface_file:gsub("[^%w]", "_") or P.surface, "v1", n, h, T,
+  P.porosity, P.seed, P.gap)
+local cache_file = P.cache .. "/joint_" .. key .. ".h5"
+local LOWER, UPPER, POROSITY = 1, 2, 1
+
+local function build_specimen()
+  local w = asperity.world{material = mat.contact, damping = mat.damping, density = mat.density,
+                           threads = P.threads}
+  -- Boxes: sides, floor of the lower half, roof of the upper one; the mould between them.
+  local planes = {
+    w:add_plane{point = {0, 0, 0}, normal = {1, 0, 0}},
+    w:add_plane{point = {Lx, 0, 0}, normal = {-1, 0, 0}},
+    w:add_plane{point = {0, 0, 0}, normal = {0, 1, 0}},
+    w:add_plane{point = {0, Ly, 0}, normal = {0, -1, 0}},
+    w:add_plane{point = {0, 0, -T}, normal = {0, 0, 1}},
+    w:add_plane{point = {0, 0, T}, normal = {0, 0, -1}},
+  }
+  local mesh = heightmap.mesh{heights = heights, nx = nx, ny = ny, dx = h, dy = h, origin = {0, 0, 0}}
+  local mould = w:add_mesh{vertices = mesh.vertices, triangles = mesh.triangles}
+  -- Particle count from the thesis porosity definition [3-35, 3-36] over both halves.
+  local volume = Lx * Ly * 2 * T
+  local count = radii_lib.count_for_porosity{volume = volume, porosity = P.porosity,
+                                             mean_radius = mat.packing.mean_radius}
+  local r = radii_lib.truncated_gaussian{count = count, mean = mat.packing.mean_radius,
+                                         sd = mat.packing.radius_sd, seed = P.seed}
+  log("packing %d particles in two halves of %.1f x %.1f mm (surface %s, %d x %d grid)", count,
+      Lx * 1e3, Ly * 1e3, P.surface_file ~= "" and P.surface_file or P.surface, nx, ny)
+  local packed = pack.expand(w, {min = {0, 0, -T}, max = {Lx, Ly, T}, radii = r, seed = P.seed,
+                                 volume = volume, progress = P.progress,
+                                 inside = function(x, y, z, rad)
+                                   local s = surface_z(x, y)
+                                   return z + rad < s - rad or z - rad > s + rad
+                                 end})
+  log("packed in %d steps (%.0f s): porosity %.3f nominal, %.3f true", packed.steps,
+      packed.seconds, packed.porosity_nominal, packed.porosity_true)
+  -- Halves by side of the mould; tags 1 (lower) and 2 (upper).
+  local pos = w:positions()
+  local lower, upper = {}, {}
+  for id = 1, w:particle_count() do
+    local p = pos[id]
+    if p[3] < surface_z(p[1], p[2]) then lower[#lower + 1] = id else upper[#upper + 1] = id end
+  end
+  w:set_tag(lower, LOWER)
+  w:set_tag(upper, UPPER)
+  -- Bond each half on its own (never across the mould), unbreakable while prepared.
+  local bonds = w:install_bonds{breakable = false, ids = lower} + w:install_bonds{breakable = false, ids = upper}
+  -- Remove the walls, part the halves by `gap`, relax [scenarios.md 3.3].
+  for _, p in ipairs(planes) do w:remove_wall(p) end
+  w:remove_wall(mould)
+  for _, id in ipairs(upper) do
+    local p = w:position(id)
+    w:set_position(id, {p[1], p[2], p[3] + P.gap})
+  end
+  local steps, why = w:run{stop_when = "equilibrium", ratio = 1e-4, steps = 200000,
+                           progress = P.progress}
+  log("bonded (%d bonds), walls removed, relaxed in %d steps (%s)", bonds, steps, why)
+  w:save(cache_file)
+  asperity.write_json(cache_file .. ".json", {particles = w:particle_count(), lower = #lower,
+    upper = #upper, bonds = bonds, porosity_nominal = packed.porosity_nominal,
+    porosity_true = packed.porosity_true, packing_steps = packed.steps, relax_steps = steps,
+    packing_seconds = packed.seconds})
+  return w
+end
+
+local world
+local f = io.open(cache_file, "r")
+if f then
+  f:close()
+  log("reusing the cached specimen %s", cache_file)
+  world = asperity.load(cache_file, {threads = P.threads})
+else
+  world = build_specimen()
+end
+local specimen_info = (function()
+  local fh = io.open(cache_file .. ".json")
+  if not fh then return {} end
+  local text = fh:read("a")
+  fh:close()
+  return {json = text}
+end)()
+
+local N = world:particle_count()
+local lower, upper = {}, {}
+for id = 1, N do if world:tag(id) == LOWER then lower[#lower + 1] = id else upper[#upper + 1] = id end end
+
+-- 3. The DEM surfaces: profilometer, mean plane, surface vs porosity particles ---------------
+local pos, rad = world:positions(), world:radii()
+local prof_lower = asperity.surface.profilometer{positions = pos, radii = rad, grid = map,
+                                                 side = "lower", ids = lower}
+local prof_upper = asperity.surface.profilometer{positions = pos, radii = rad, grid = map,
+                                                 side = "upper", ids = upper,
+                                                 origin = {0, 0}}
+local plane_lower = asperity.surface.mean_plane(prof_lower, map)
+local cls = asperity.surface.classify(prof_lower, map, P.band > 0 and {band = P.band} or nil)
+-- The upper half sits `gap` higher: its own mean plane (the shift) accounts for that.
+local cls_up_shifted = asperity.surface.classify(prof_upper, map, P.band > 0 and {band = P.band} or nil)
+local porosity_ids = {}
+for _, id in ipairs(cls.porosity) do porosity_ids[#porosity_ids + 1] = id end
+for _, id in ipairs(cls_up_shifted.porosity) do porosity_ids[#porosity_ids + 1] = id end
+world:set_flags(porosity_ids, POROSITY)
+log("DEM surface: mean plane dv = %.3g mm, %.0f %% of nodes coinciding; %.0f %% of the " ..
+    "profilometer particles are on the expected surface", plane_lower.shift * 1e3,
+    100 * plane_lower.coinciding_fraction, 100 * cls.retained_fraction)
+
+-- 4. The model, platens ----------------------------------------------------------------------
+local area = Lx * Ly
+local stress_scale = mat.rock.young_modulus / mat.rev.young_modulus    -- [3-37]
+local target_stress = P.stress * 1e6 / stress_scale                   -- model units, Pa
+local function mpa(sigma) return sigma * stress_scale / 1e6 end
+local zlo, zhi = math.huge, -math.huge
+for id = 1, N do
+  local z = pos[id][3]
+  zlo, zhi = math.min(zlo, z), math.max(zhi, z)
+end
+local bottom, top
+if P.model == "rigid" then
+  world:remove_bonds()
+  bottom = world:add_group(lower, {translation = "fixed"})
+  top = world:add_group(upper, {translation = {"fixed", "fixed", "velocity"}, velocity = {0, 0, 0}})
+  -- Only particles within reach of the other half are simulated: the rest of each half is inert
+  -- [model.md 6]. A particle deeper than two diameters below its half's surface (profilometer,
+  -- over the neighbourhood it could slide under) can never be touched.
+  local reach = 4 * mat.packing.mean_radius * 1.6
+  local inert = {}
+  local lo_s, up_s = prof_lower.surface, prof_upper.surface
+  local function local_extreme(s, x, y, upper_side)
+    local best = upper_side and math.huge or -math.huge
+    local i0, j0 = math.floor(x / h) + 1, math.floor(y / h) + 1
+    local k = math.ceil(reach / h)
+    for j = math.max(1, j0 - k), math.min(ny, j0 + k) do
+      for i = math.max(1, i0 - k), math.min(nx, i0 + k) do
+        local z = s:at(i, j)
+        if z == z then best = upper_side and math.min(best, z) or math.max(best, z) end
+      end
+    end
+    return best
+  end
+  for _, id in ipairs(lower) do
+    local p = pos[id]
+    if p[3] + rad[id] < local_extreme(lo_s, p[1], p[2], false) - reach then inert[#inert + 1] = id end
+  end
+  for _, id in ipairs(upper) do
+    local p = pos[id]
+    if p[3] - rad[id] > local_extreme(up_s, p[1], p[2], true) + reach then inert[#inert + 1] = id end
+  end
+  world:set_inert(inert)
+  log("rigid model: %d of %d particles inert", #inert, N)
+else
+  if P.model == "elastic" then
+    world:set_bond_strength{breakable = false}
+  else
+    world:set_bond_strength{tensile_strength = mat.rev.bond_tensile_strength}
+  end
+  local bottom_ids, top_ids = {}, {}
+  for id = 1, N do
+    local z = pos[id][3]
+    if z < zlo + P.platen then bottom_ids[#bottom_ids + 1] = id end
+    if z > zhi - P.platen then top_ids[#top_ids + 1] = id end
+  end
+  bottom = world:add_group(bottom_ids, {translation = "fixed"})
+  top = world:add_group(top_ids, {translation = {"fixed", "fixed", "velocity"}, velocity = {0, 0, 0}})
+end
+
+-- 5. Assembly: bring the halves together until exactly one contact exists [4.2.1] ------------
+local function between() return world:contact_summary(LOWER, UPPER, POROSITY) end
+world:set_group_motion(top, {velocity = {0, 0, -P.approach_velocity}})
+local steps = world:run{steps = 10000000, every = 1, progress = P.progress,
+                        stop_when = function(w) return w:contact_summary(LOWER, UPPER).count >= 1 end}
+world:set_group_motion(top, {velocity = {0, 0, 0}})
+log("halves in contact after %d steps", steps)
+
+-- 6. Closure at constant velocity to the normal stress [thesis 4.2.2] -----------------------
+local z_contact = world:group_position(top)[3]
+local closure = asperity.series{"closure [m]", "closure_corrected [m]", "normal_stress [Pa]",
+  "normal_stress_mpa [MPa]", "contacts [1]", "contact_area [%]", "broken_bonds [1]", "time [s]"}
+local height = zhi - zlo
+-- Force of the particles on the upper platen (the group force less any applied dead load).
+local applied_z = 0
+local function platen_force()
+  local f = world:group_force(top)
+  return {f[1], f[2], f[3] - applied_z}
+end
+local function normal_stress() return platen_force()[3] / area end
+local function record_closure()
+  local s = normal_stress()
+  local c = between()
+  local d = z_contact - world:group_position(top)[3]
+  closure:record(d, d - s * height / mat.rev.young_modulus, s, mpa(s), c.count,
+                 100 * c.area / area, world:break_count(), world:time())
+end
+world:set_group_motion(top, {velocity = {0, 0, -P.closure_velocity}})
+record_closure()
+world:run{steps = 10000000, every = 1, progress = P.progress,
+          callback = function(w) if w:step() % 500 == 0 then record_closure() end end,
+          stop_when = function() return normal_stress() >= target_stress end}
+record_closure()
+log("closed to %.3g MPa in %.1f um", mpa(normal_stress()), 1e6 * (z_contact - world:group_position(top)[3]))
+closure:write(P.out .. "/closure")
+
+-- Normal stiffness: slope of stress against closure over the upper half of the loading.
+local function fit(xs, ys)
+  local n_, sx, sy, sxx, sxy = #xs, 0, 0, 0, 0
+  if n_ < 2 then return 0/0 end
+  for k = 1, n_ do sx, sy, sxx, sxy = sx + xs[k], sy + ys[k], sxx + xs[k] ^ 2, sxy + xs[k] * ys[k] end
+  return (n_ * sxy - sx * sy) / (n_ * sxx - sx * sx)
+end
+local cd, cs = closure:column("closure"), closure:column("normal_stress_mpa")
+local kx, ky = {}, {}
+for k = 1, closure:rows() do
+  if cs[k] >= 0.5 * P.stress then kx[#kx + 1] = cd[k] * 1e3; ky[#ky + 1] = cs[k] end
+end
+local normal_stiffness = fit(kx, ky)   -- MPa/mm
+
+-- 7. Shear under constant normal load [thesis 4.3.1] ---------------------------------------
+local axis = P.direction == "x" and 1 or 2
+local shear_velocity = {0, 0, 0}
+shear_velocity[axis] = -P.velocity
+-- Constant normal load. "load": the platen is free along z under a constant applied force, a dead
+-- weight: it follows any dilatancy at once and the load it transmits differs from the target only
+-- by its inertia. "servo" (model.md 7): the platen's z velocity follows the force error; its
+-- stable gain is set by the stiff platen-specimen bonds, so it lags when the joint dilates fast.
+local modes = {"fixed", "fixed", P.normal_control == "servo" and "servo" or "free"}
+modes[axis] = "velocity"
+if P.normal_control == "servo" then
+  world:set_group_motion(top, {translation = modes, velocity = shear_velocity,
+                               servo = {target_force = target_stress * area, max_velocity = 10 * P.velocity}})
+elseif P.normal_control == "load" then
+  world:set_group_motion(top, {translation = modes, velocity = shear_velocity})
+  applied_z = -target_stress * area
+  world:set_group_force(top, {0, 0, applied_z})
+else
+  error("normal_control must be load or servo, got '" .. P.normal_control .. "'")
+end
+-- Let the platen settle on the target load before shearing.
+do
+  local hold = {table.unpack(modes)}
+  hold[axis] = "fixed"
+  local v0 = {0, 0, 0}
+  world:set_group_motion(top, {translation = hold, velocity = v0})
+  world:run{steps = 200000, every = 100, progress = P.progress,
+            stop_when = function(w)
+              return math.abs(normal_stress() / target_stress - 1) < 0.002 and w:unbalanced_force_ratio() < 1e-3
+            end}
+  world:set_group_motion(top, {translation = modes, velocity = shear_velocity})
+end
+local shear = asperity.series{"displacement [mm]", "shear_stress [Pa]", "shear_stress_mpa [MPa]",
+  "normal_stress_mpa [MPa]", "dilatancy [mm]", "contacts [1]", "contact_area [%]",
+  "broken_bonds [1]", "porosity_shear_stress_mpa [MPa]", "kinetic [J]", "strain [J]",
+  "friction [J]", "damping [J]", "released [J]", "boundary_work [J]", "shear_work [J]",
+  "dilatancy_work [J]", "time [s]"}
+local c0 = world:group_position(top)
+local e0 = world:energies()
+local shear_work, dilatancy_work = 0, 0
+local last_pos, last_force = c0, platen_force()
+local snaps = asperity.snapshots{dir = P.out, name = "joint"}
+local snap_at = {}
+for v in P.snapshots:gmatch("[^,]+") do snap_at[#snap_at + 1] = tonumber(v) end
+local next_snap = 1
+local contact_points = {}
+local function displacement() return (c0[axis] - world:group_position(top)[axis]) * 1e3 end
+local function record_shear()
+  local p, f = world:group_position(top), platen_force()
+  -- Work of the agent on the specimen: the force it applies is minus the particles' force.
+  shear_work = shear_work - 0.5 * (f[axis] + last_force[axis]) * (p[axis] - last_pos[axis])
+  dilatancy_work = dilatancy_work - 0.5 * (f[3] + last_force[3]) * (p[3] - last_pos[3])
+  last_pos, last_force = p, f
+  local c = between()
+  local tau = f[axis] / area   -- the lower half resists the upper one moving along -axis
+  local e = world:energies()
+  shear:record(displacement(), tau, mpa(tau), mpa(f[3] / area), (p[3] - c0[3]) * 1e3, c.count,
+               100 * c.area / area, world:break_count(), mpa(c.flagged_force[axis] / area),
+               e.kinetic, e.strain - e0.strain, e.friction - e0.friction, e.damping - e0.damping,
+               e.released - e0.released, e.boundary_work - e0.boundary_work, shear_work,
+               dilatancy_work, world:time())
+  while next_snap <= #snap_at and displacement() >= snap_at[next_snap] - 1e-9 do
+    snaps:write(world)
+    local pts = {}
+    for _, ct in ipairs(world:contacts()) do
+      if world:tag(ct.a) ~= world:tag(ct.b) then pts[#pts + 1] = {ct.point[1], ct.point[2]} end
+    end
+    contact_points[#contact_points + 1] = {at = snap_at[next_snap], points = pts}
+    next_snap = next_snap + 1
+  end
+end
+record_shear()
+local record_every = math.max(1, math.floor(P.record * 1e-3 / (P.velocity * world:dt()) + 0.5))
+world:run{steps = 100000000, every = 1, progress = P.progress,
+          callback = function(w) if w:step() % record_every == 0 then record_shear() end end,
+          stop_when = function() return displacement() >= P.shear end,
+          show = function()
+            return {disp_mm = displacement(), tau_mpa = mpa(platen_force()[axis] / area),
+                    sigma_mpa = mpa(normal_stress())}
+          end}
+record_shear()
+shear:write(P.out .. "/shear")
+log("sheared %.2f mm", displacement())
+
+-- 8. Summary --------------------------------------------------------------------------------
+local u, tau = shear:column("displacement"), shear:column("shear_stress_mpa")
+local dil, sn = shear:column("dilatancy"), shear:column("normal_stress_mpa")
+local cnt = shear:column("contacts")
+local rows = shear:rows()
+local peak, at = -math.huge, 1
+for k = 1, rows do if tau[k] > peak then peak, at = tau[k], k end end
+local residual, m = 0, 0
+for k = 1, rows do if u[k] >= u[rows] - 0.5 then residual, m = residual + tau[k], m + 1 end end
+residual = residual / math.max(m, 1)
+-- Initial shear stiffness: slope over the first 30 % of the peak stress.
+local sx, sy = {}, {}
+for k = 1, at do if tau[k] <= 0.3 * peak then sx[#sx + 1] = u[k]; sy[#sy + 1] = tau[k] end end
+local ks = fit(sx, sy)
+local max_dil = -math.huge
+for k = 1, rows do max_dil = math.max(max_dil, dil[k]) end
+local function slope_at(k)
+  local a, b = math.max(1, k - 5), math.min(rows, k + 5)
+  return (dil[b] - dil[a]) / math.max(u[b] - u[a], 1e-12)
+end
+-- Contact decay N = N0 d^q after the maximum count.
+local cmax, cat = -1, 1
+for k = 1, rows do if cnt[k] > cmax then cmax, cat = cnt[k], k end end
+local lx, ly = {}, {}
+for k = cat, rows do
+  if u[k] > 0 and cnt[k] > 0 then lx[#lx + 1] = math.log(u[k]); ly[#ly + 1] = math.log(cnt[k]) end
+end
+local q = fit(lx, ly)
+local sn_dev = 0
+for k = 1, rows do if u[k] > 0.05 then sn_dev = math.max(sn_dev, math.abs(sn[k] / P.stress - 1)) end end
+local e = world:energies()
+local input = e.boundary_work - e0.boundary_work
+local function share(v) return input ~= 0 and v / input or 0/0 end
+local summary = {
+  parameters = P,
+  surface = {nx = nx, ny = ny, spacing = h, side_x = Lx, side_y = Ly},
+  n_particles = N,
+  n_lower = #lower,
+  n_upper = #upper,
+  inert_particles = world:inert_count(),
+  bonds = world:bond_count(),
+  stress_scale = stress_scale,
+  target_stress_pa = target_stress,
+  peak_shear_stress_mpa = peak,
+  peak_displacement_mm = u[at],
+  residual_shear_stress_mpa = residual,
+  initial_shear_stiffness_mpa_per_mm = ks,
+  max_dilatancy_mm = max_dil,
+  dilatancy_angle_at_peak_deg = math.deg(math.atan(slope_at(at))),
+  normal_stiffness_mpa_per_mm = normal_stiffness,
+  normal_stress_max_deviation = sn_dev,
+  broken_bonds = world:break_count(),
+  contact_decay_exponent = q,
+  max_contacts = cmax,
+  dem_surface = {mean_plane_shift_m = plane_lower.shift,
+                 coinciding_fraction = plane_lower.coinciding_fraction,
+                 surface_particle_fraction = cls.retained_fraction,
+                 band_m = cls.band},
+  energy_shares = {friction = share(e.friction - e0.friction), damping = share(e.damping - e0.damping),
+                   strain = share(e.strain - e0.strain), kinetic = share(e.kinetic - e0.kinetic),
+                   released = share(e.released - e0.released)},
+  input_work_j = input,
+  energy_balance_error = share(world:energy_balance(e0)),
+  steps = world:step(),
+  dt = world:dt(),
+  wall_seconds = asperity.wall_time() - t_start,
+  specimen_cache = cache_file,
+}
+asperity.write_json(P.out .. "/summary.json", summary)
+
+-- 9. Plots ----------------------------------------------------------------------------------
+pcall(function()
+  local title = ("%s, %s model, %g MPa, shear along -%s"):format(P.surface, P.model, P.stress, P.direction)
+  shear:plot{file = P.out .. "/shear_stress.png", x = "displacement", y = {"shear_stress_mpa"}, title = title}
+  shear:plot{file = P.out .. "/dilatancy.png", x = "displacement", y = {"dilatancy"}, title = title}
+  shear:plot{file = P.out .. "/contacts.png", x = "displacement", y = {"contacts"}, title = title}
+  shear:plot{file = P.out .. "/broken_bonds.png", x = "displacement", y = {"broken_bonds"}, title = title}
+  shear:plot{file = P.out .. "/energies.png", x = "displacement",
+             y = {"boundary_work", "friction", "damping", "strain", "released"}, title = title}
+  closure:plot{file = P.out .. "/closure.png", x = "closure", y = {"normal_stress_mpa"}, title = title}
+end)
+-- Contact points at the last snapshot and broken bonds over the elevation map.
+pcall(function()
+  local pts = contact_points[#contact_points]
+  local data = os.tmpname()
+  local fh = assert(io.open(data, "w"))
+  for j = 1, ny do
+    for i = 1, nx do fh:write(("%.6g %.6g %.6g\n"):format((i - 1) * h * 1e3, (j - 1) * h * 1e3, heights[(j - 1) * nx + i] * 1e3)) end
+    fh:write("\n")
+  end
+  fh:write("\n\n")
+  if pts then for _, p in ipairs(pts.points) do fh:write(("%.6g %.6g 0\n"):format(p[1] * 1e3, p[2] * 1e3)) end end
+  fh:write("NaN NaN NaN\n\n\n")
+  for _, ev in ipairs(world:break_events()) do
+    fh:write(("%.6g %.6g 0\n"):format(ev.position[1] * 1e3, ev.position[2] * 1e3))
+  end
+  fh:write("NaN NaN NaN\n")
+  fh:close()
+  local script = os.tmpname()
+  local gp = assert(io.open(script, "w"))
+  gp:write(([[set terminal pngcairo noenhanced size 900,800
+set output "%s"
+set title "%s: contacts between the halves at %s mm (black), broken bonds (white)"
+set xlabel "x [mm]"
+set ylabel "y [mm]"
+set cblabel "elevation [mm]"
+set size ratio -1
+set view map
+plot "%s" index 0 using 1:2:3 with image notitle, "%s" index 1 using 1:2 with points pt 7 ps 0.6 lc rgb "black" title "contacts", "%s" index 2 using 1:2 with points pt 6 ps 0.6 lc rgb "white" title "broken bonds"
+]]):format(P.out .. "/contact_map.png", P.surface, pts and tostring(pts.at) or "?", data, data, data))
+  gp:close()
+  os.execute("gnuplot " .. script .. " 2>/dev/null")
+  os.remove(script)
+  os.remove(data)
+end)
+
+print(("%s %s %g MPa -%s: %d particles, peak %.2f MPa at %.2f mm, residual %.2f MPa, " ..
+       "max dilatancy %.3f mm, %d broken bonds, %.0f s"):format(P.surface, P.model, P.stress,
+  P.direction, N, peak, u[at], residual, max_dil, world:break_count(), summary.wall_seconds))

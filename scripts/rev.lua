@@ -1,0 +1,450 @@
+-- The REV: a 1 cm cube of bonded particles, packed, bonded, freed and tested in uniaxial
+-- compression, tension and direct shear [thesis 3.3.1, 3.3.2; scenarios.md 1-2].
+--
+--   build/asperity run scripts/rev.lua out=out/rev                    # defaults (a few minutes)
+--   build/asperity run scripts/rev.lua tensile_strength=0.03 seed=2 out=out/rev2
+--   build/asperity run scripts/rev.lua rate_check=true out=out/rev_rate   # also at half the rate
+--
+-- 1. Packing (pack.expand): N = (1 - n) V / (4/3 pi <R>^3) particles (935), radii Gaussian
+--    0.5 +- 0.1 mm cut at 3 SD, radius expansion from 1/10 in frictionless walls, then cycling to
+--    the unbalanced-force ratio 1e-4. Then the isotropic stress installation (pack.install_stress):
+--    radii scaled by a common factor until the wall stress is `packing_stress` (the stress locked
+--    into the packing becomes internal bond stress when the walls go; see below).
+-- 2. Two copies of the packing get bonds (every contact; beam_kn = kn, beam_ks = ks): unbreakable
+--    (the elastic model: E, nu, G) and breakable with the elliptic criterion of strength st
+--    (`tensile_strength`; strengths). Walls removed, cycled to equilibrium. The bond stresses left
+--    are reported (histogram, CSV) with the strength each bond needs to hold.
+-- 3. Platens: particles within `platen` of the bottom / top face, rigid groups, rotation fixed;
+--    bottom fixed, top moved at `rate`. Stress = platen force / L^2 [3-43, 3-44]; strains from
+--    particle layers at 1/4 and 3/4 height and the lateral faces (specimen.lua) [3-38..3-42].
+--    Elastic compression and tension to `elastic_strain`, direct shear (top along +x) to the same
+--    shear strain; fracture compression and tension until the stress falls to `stop_fraction` of
+--    its peak.
+--
+-- Outputs in `out`: summary.json; series (HDF5 + CSV) and stress-strain PNGs per test;
+-- bond_stresses.csv / .png (after wall removal); broken-bond maps (PNG + CSV) of the fracture tests;
+-- checkpoints packed.h5, elastic.h5, fracture.h5 (asperity.load continues from them).
+--
+-- Stresses are reported in model units (Pa) and scaled to the rock [3-37]:
+-- sigma_rock = sigma * E_exp / E_REV, E_exp = 30 853 MPa (Table 3-1).
+local mat = require("materials")
+local radii = require("radii")
+local pack = require("pack")
+local walls = require("walls")
+local eq = require("equilibrium")
+local specimen = require("specimen")
+local figures = require("figures")
+
+local P = require("params").defaults{
+  size = 0.01, porosity = mat.packing.porosity, seed = 1,
+  mean_radius = mat.packing.mean_radius, radius_sd = mat.packing.radius_sd,
+  kn = mat.contact.kn, ks = mat.contact.ks, friction = mat.contact.friction,
+  damping = mat.damping, density = mat.density,
+  tensile_strength = mat.rev.bond_tensile_strength,  -- Pa, bond st (elliptic criterion)
+  packing_stress = mat.rev.packing_stress,           -- Pa, wall stress before bonding; 0: as packed
+  rate = 1e-6,               -- m/s, platen velocity (thesis: 1 um/s)
+  elastic_strain = 2e-4,     -- strain reached in the elastic tests
+  stop_fraction = 0.7,       -- fracture tests stop when |stress| < this x peak (after the peak)
+  max_strain = 0.02,         -- ... or at this strain
+  platen = 1e-3,             -- m, platen thickness (particles within it of the face)
+  ratio = 1e-4,              -- equilibrium: mean unbalanced / mean contact force
+  every = 100,               -- steps between recorded rows
+  tests = "elastic,shear,compression,tension",   -- which tests to run
+  rate_check = false,
+  lock_rotation = true,      -- model.md 2: bonded particles do not rotate
+  threads = 1,
+  out = "out/rev",
+}
+local out = asperity.mkdir(P.out)
+local want = {}
+for name in P.tests:gmatch("[^,%s]+") do
+  if not ({elastic = true, shear = true, compression = true, tension = true})[name] then
+    error("tests: unknown test '" .. name .. "' (elastic, shear, compression, tension)")
+  end
+  want[name] = true
+end
+want.elastic = want.elastic or want.shear   -- the shear test compares with E and nu
+local L = P.size
+local area = L * L
+local clock0 = asperity.wall_time()
+local timings = {}
+local function timed(name, fn, ...)
+  local t = asperity.wall_time()
+  local r = table.pack(fn(...))
+  timings[name] = asperity.wall_time() - t
+  return table.unpack(r, 1, r.n)
+end
+local function log(fmt, ...) io.write((fmt .. "\n"):format(...)); io.flush() end
+
+local function new_world()
+  return asperity.world{material = {kn = P.kn, ks = P.ks, friction = P.friction}, damping = P.damping,
+                        density = P.density, threads = P.threads, lock_bonded_rotation = P.lock_rotation}
+end
+
+-- 1. Packing --------------------------------------------------------------------------------------
+local function make_packing()
+  local w = new_world()
+  local lo, hi = {0, 0, 0}, {L, L, L}
+  local box = walls.box(w, {min = lo, max = hi, material = {kn = P.kn, ks = P.ks, friction = 0}})
+  local n = radii.count_for_porosity{volume = L ^ 3, porosity = P.porosity, mean_radius = P.mean_radius}
+  local r = radii.truncated_gaussian{count = n, mean = P.mean_radius, sd = P.radius_sd, cut = mat.packing.cut,
+                                     seed = P.seed, normalise_mean = true}
+  local res = pack.expand(w, {min = lo, max = hi, radii = r, seed = P.seed, walls = box, ratio = P.ratio})
+  log("packed %d particles in %d steps (%.1f s): wall stress %.4g Pa, coordination %.2f",
+      n, res.steps, res.seconds, res.wall_stress.top, res.coordination)
+  local info = {n_particles = n, expansion = res, wall_stress_expanded_pa = res.wall_stress}
+  if P.packing_stress > 0 then
+    local s = pack.install_stress(w, {first = res.first, last = res.last, walls = box, min = lo, max = hi,
+                                      target = P.packing_stress, ratio = P.ratio})
+    log("stress installation: radii x %.5f, wall stress %.4g Pa (target %.4g) after %d iterations",
+        s.factor, s.stress, P.packing_stress, s.iterations)
+    info.stress_installation = s
+  end
+  local rr = w:radii():flat()
+  info.porosity_nominal, info.porosity_true, info.mean_radius = radii.porosity(rr, L ^ 3)
+  info.radius_stats = radii.stats(rr)
+  info.wall_stress_pa = pack.box_wall_stresses(w, box, lo, hi)
+  info.coordination = 2 * w:contact_count() / n
+  info.box = box
+  w:save(out .. "/packed.h5")
+  return info
+end
+local packing = timed("packing", make_packing)
+
+-- 2. Bonding, wall removal, relaxation --------------------------------------------------------------
+local function bonded(material)
+  local w = asperity.load(out .. "/packed.h5", {threads = P.threads})
+  local count = w:install_bonds(material)
+  for _, id in pairs(packing.box) do w:remove_wall(id) end
+  local steps, reached, ratio = eq.run(w, {ratio = P.ratio, steps = 1000000})
+  return w, {bonds = count, relax_steps = steps, relax_reached = reached, relax_ratio = ratio,
+             broken_in_relaxation = w:break_count()}
+end
+
+local bond_material = {beam_kn = P.kn, beam_ks = P.ks, radius_factor = 1}
+local function with(t, extra)
+  local c = {}
+  for k, v in pairs(t) do c[k] = v end
+  for k, v in pairs(extra) do c[k] = v end
+  return c
+end
+
+local welastic, elastic_info = timed("bond_relax_elastic", bonded, with(bond_material, {breakable = false}))
+log("elastic model: %d bonds, relaxed in %d steps (ratio %.2g)", elastic_info.bonds, elastic_info.relax_steps,
+    elastic_info.relax_ratio)
+
+-- Bond stresses left after wall removal, and the strength each bond needs to hold.
+local function residual_stresses(w)
+  local sig, tau, need = {}, {}, {}
+  local f = assert(io.open(out .. "/bond_stresses.csv", "w"))
+  f:write("a,b,sigma [Pa],tau [Pa],strength_to_hold [Pa]\n")
+  for _, b in ipairs(w:bonds()) do
+    local s = mat.strength_to_hold(b.sigma, b.tau)
+    sig[#sig + 1], tau[#tau + 1], need[#need + 1] = b.sigma, b.tau, s
+    f:write(("%d,%d,%.10g,%.10g,%.10g\n"):format(b.a, b.b, b.sigma, b.tau, s))
+  end
+  f:close()
+  local function quantile(v, q)
+    local c = {}
+    for i = 1, #v do c[i] = v[i] end
+    table.sort(c)
+    return c[math.max(1, math.ceil(q * #c))]
+  end
+  local stats = {sigma_max_pa = quantile(sig, 1), sigma_min_pa = quantile(sig, 1 / #sig),
+                 sigma_p99_pa = quantile(sig, 0.99), tau_max_pa = quantile(tau, 1),
+                 strength_to_hold_max_pa = quantile(need, 1), strength_to_hold_p99_pa = quantile(need, 0.99),
+                 strength_to_hold_p90_pa = quantile(need, 0.90), bonds = #sig}
+  local ms = 0
+  for i = 1, #sig do ms = ms + sig[i] end
+  stats.sigma_mean_pa = ms / #sig
+  figures.histogram{file = out .. "/bond_stresses_sigma.png", values = sig, bins = 50,
+                    xlabel = "sigma [Pa]", csv = out .. "/bond_stresses_sigma_hist.csv",
+                    title = "Bond normal stress after wall removal (tension +)",
+                    marks = {{x = P.tensile_strength, label = "st"}}}
+  figures.histogram{file = out .. "/bond_stresses_strength.png", values = need, bins = 50, min = 0,
+                    xlabel = "strength to hold [Pa]", csv = out .. "/bond_stresses_strength_hist.csv",
+                    title = "Bond strength each bond needs after wall removal (elliptic criterion)",
+                    marks = {{x = P.tensile_strength, label = "st"}}}
+  return stats
+end
+local residual = residual_stresses(welastic)
+log("bond stresses after wall removal: sigma %.3g .. %.3g Pa, strength to hold max %.3g Pa (p99 %.3g)",
+    residual.sigma_min_pa, residual.sigma_max_pa, residual.strength_to_hold_max_pa, residual.strength_to_hold_p99_pa)
+
+-- 3. Platens and gauges -------------------------------------------------------------------------------
+local function prepare(w, name)
+  local pl = specimen.platens(w, {thickness = P.platen})
+  local g = specimen.gauges(w, {platens = pl})
+  w:save(out .. "/" .. name .. ".h5")
+  return pl, g
+end
+local platens, gauges = prepare(welastic, "elastic")
+welastic = nil
+collectgarbage()
+local function mean_z(w, set)
+  local pos, s = w:positions(), 0
+  for _, id in ipairs(set) do s = s + pos:get(id, 3) end
+  return s / #set
+end
+
+-- One test from a checkpoint: the top platen moves at `velocity`; rows every P.every steps;
+-- `stop(row, peak)` ends it. slab = true also records the mean stress tensor of the middle slab.
+local columns = {"step", "time [s]", "displacement [m]", "axial_stress [Pa]", "shear_stress [Pa]",
+                 "axial_strain", "lateral_strain", "strain_x", "strain_y", "shear_strain",
+                 "shear_strain_layers", "broken_bonds", "slab_xx [Pa]", "slab_yy [Pa]", "slab_zz [Pa]",
+                 "slab_xz [Pa]", "slab_zx [Pa]"}
+local function run_test(checkpoint, name, velocity, o)
+  local t0 = asperity.wall_time()
+  local w = asperity.load(out .. "/" .. checkpoint .. ".h5", {threads = P.threads})
+  local meter = specimen.strain_meter(w, gauges)
+  local zlo, zhi = mean_z(w, gauges.lower), mean_z(w, gauges.upper)
+  local s0 = o.slab and specimen.slab_stress(w, zlo, zhi, area)
+  local start = w:group_position(platens.top)
+  local dir = velocity[1] ~= 0 and 1 or 3
+  local series = asperity.series(with(columns, {attributes = {test = name, rate = P.rate, size = L}}))
+  w:set_group_velocity(platens.top, velocity)
+  local peak, peak_row = 0, nil
+  local last
+  local function row(w)
+    local e, s = meter:read(w), specimen.stresses(w, platens, area)
+    local p = w:group_position(platens.top)
+    local r = {step = w:step(), time = w:time(), displacement = (dir == 1 and p.x - start.x or p.z - start.z),
+               axial_stress = s.axial, shear_stress = s.shear_x, axial_strain = e.axial,
+               lateral_strain = e.lateral, strain_x = e.x, strain_y = e.y, shear_strain = e.shear_xz,
+               shear_strain_layers = e.shear_xz_layers, broken_bonds = w:break_count(),
+               slab_xx = 0, slab_yy = 0, slab_zz = 0, slab_xz = 0, slab_zx = 0}
+    if s0 then
+      local t = specimen.slab_stress(w, zlo, zhi, area)
+      r.slab_xx, r.slab_yy, r.slab_zz = t[1][1] - s0[1][1], t[2][2] - s0[2][2], t[3][3] - s0[3][3]
+      r.slab_xz, r.slab_zx = t[1][3] - s0[1][3], t[3][1] - s0[3][1]
+    end
+    series:record(r)
+    return r
+  end
+  row(w)
+  local steps = w:run{steps = o.max_steps or 100000000, every = P.every,
+    stop_when = function(w)
+      last = row(w)
+      local v = o.value(last)
+      if math.abs(v) > peak then peak, peak_row = math.abs(v), last end
+      return o.stop(last, peak)
+    end,
+    show = function() return last and {stress = o.value(last), peak = peak, broken = w:break_count()} end}
+  local result = {series = series, peak = peak, peak_row = peak_row, steps = steps,
+                  seconds = asperity.wall_time() - t0, world = w}
+  series:write(out .. "/" .. name)
+  return result
+end
+
+local function column(series, name) return series:column(name):flat() end
+
+-- Linear fits over the part of the test beyond 20 % of its final strain (the start-up of the
+-- platen is left out).
+local function fit(series, xname, yname, strain_name)
+  local x, y, e = column(series, xname), column(series, yname), column(series, strain_name or xname)
+  local emax = math.abs(e[#e])
+  return specimen.fit_line(x, y, function(i) return math.abs(e[i]) >= 0.2 * emax end)
+end
+
+local function elastic_axial(name, sign)
+  local r = run_test("elastic", name, {0, 0, sign * P.rate}, {slab = true,
+    value = function(row) return row.axial_stress end,
+    stop = function(row) return math.abs(row.axial_strain) >= P.elastic_strain end})
+  local s = r.series
+  local E, _, r2 = fit(s, "axial_strain", "axial_stress")
+  local nu = -fit(s, "axial_strain", "lateral_strain")
+  -- End restraint: the bonded platens hold the ends from spreading, so the middle slab is not in
+  -- uniaxial stress; with the slab's mean stress tensor, isotropic elasticity gives E and nu:
+  -- E ezz = szz - nu (sxx + syy), E elat = slat - nu (szz + slat).
+  local sz = fit(s, "axial_strain", "slab_zz")
+  local sl = (fit(s, "axial_strain", "slab_xx") + fit(s, "axial_strain", "slab_yy")) / 2
+  local rl = fit(s, "axial_strain", "lateral_strain")
+  local nu_c = (sl - sz * rl) / (sz + sl - 2 * sl * rl)
+  local E_c = sz - 2 * nu_c * sl
+  s:plot{file = out .. "/" .. name .. ".png", x = "axial_strain", y = {"axial_stress"},
+         title = ("%s: E = %.4g Pa, nu = %.3f"):format(name, E, nu)}
+  log("%-20s E = %.4g Pa (R2 %.5f), nu = %.4f; slab-corrected E = %.4g Pa, nu = %.4f  [%d steps, %.1f s]",
+      name, E, r2, nu, E_c, nu_c, r.steps, r.seconds)
+  return {young_modulus_pa = E, poisson_ratio = nu, young_modulus_slab_pa = E_c, poisson_ratio_slab = nu_c,
+          fit_r2 = r2, steps = r.steps, seconds = r.seconds, lateral_confinement = sl / sz}
+end
+
+local elastic
+local E, nu, E_slab, nu_slab = mat.rev.young_modulus, nil, nil, nil
+if want.elastic then
+  elastic = {}
+  timed("elastic_compression", function() elastic.compression = elastic_axial("elastic_compression", -1) end)
+  timed("elastic_tension", function() elastic.tension = elastic_axial("elastic_tension", 1) end)
+  E = (elastic.compression.young_modulus_pa + elastic.tension.young_modulus_pa) / 2
+  nu = (elastic.compression.poisson_ratio + elastic.tension.poisson_ratio) / 2
+  E_slab = (elastic.compression.young_modulus_slab_pa + elastic.tension.young_modulus_slab_pa) / 2
+  nu_slab = (elastic.compression.poisson_ratio_slab + elastic.tension.poisson_ratio_slab) / 2
+end
+
+local shear
+if want.shear then
+  timed("shear", function()
+    local r = run_test("elastic", "shear", {P.rate, 0, 0}, {slab = true,
+      value = function(row) return row.shear_stress end,
+      stop = function(row) return math.abs(row.shear_strain_layers) >= P.elastic_strain end})
+    local s = r.series
+    local G = fit(s, "shear_strain", "shear_stress", "shear_strain_layers")
+    local G_layers = fit(s, "shear_strain_layers", "shear_stress")
+    -- The symmetric part of the slab's mean stress: with rotations locked the stress tensor is not
+    -- symmetric (the locks take the moment of the contact forces), and only its symmetric part
+    -- belongs to the strain (tau = G gamma of an isotropic solid).
+    local x, z, zx = column(s, "shear_strain"), column(s, "slab_xz"), column(s, "slab_zx")
+    local sym = {}
+    for i = 1, #z do sym[i] = (z[i] + zx[i]) / 2 end
+    local e = column(s, "shear_strain_layers")
+    local emax = math.abs(e[#e])
+    local keep = function(i) return math.abs(e[i]) >= 0.2 * emax end
+    local G_sym = specimen.fit_line(x, sym, keep)
+    local G_slab_zx = specimen.fit_line(x, z, keep)
+    s:plot{file = out .. "/shear.png", x = "shear_strain", y = {"shear_stress"},
+           title = ("direct shear: G = %.4g Pa"):format(G)}
+    shear = {shear_modulus_pa = G, shear_modulus_layers_pa = G_layers, shear_modulus_symmetric_pa = G_sym,
+             shear_modulus_slab_pa = G_slab_zx, steps = r.steps, seconds = r.seconds}
+    log("%-20s G = %.4g Pa (layers only %.4g, symmetric stress %.4g); E/2(1+nu) = %.4g, slab %.4g  [%d steps, %.1f s]",
+        "shear", G, G_layers, G_sym, E / (2 * (1 + nu)), E_slab / (2 * (1 + nu_slab)), r.steps, r.seconds)
+  end)
+end
+
+-- Fracture -----------------------------------------------------------------------------------------
+local fracture
+local function break_map(w, name, title)
+  local events = w:break_events()
+  local f = assert(io.open(out .. "/" .. name .. "_breaks.csv", "w"))
+  f:write("step,time [s],x [m],y [m],z [m],a,b,mode,sigma [Pa],tau [Pa],released_energy [J]\n")
+  local modes = {tension = 1, shear = 2, compression = 3}
+  local pts = {}
+  for _, e in ipairs(events) do
+    local p = e.position
+    f:write(("%d,%.10g,%.10g,%.10g,%.10g,%d,%d,%s,%.10g,%.10g,%.10g\n"):format(
+      e.step, e.time, p.x, p.y, p.z, e.a, e.b, e.mode, e.sigma, e.tau, e.released_energy))
+    pts[#pts + 1] = {p.x, p.y, p.z, modes[e.mode]}
+  end
+  f:close()
+  local ext = specimen.extent(w)
+  figures.map{file = out .. "/" .. name .. "_breaks.png", points = pts, groups = {"tension", "shear", "compression"},
+              extent = ext, title = title}
+  local counts = {tension = 0, shear = 0, compression = 0}
+  for _, e in ipairs(events) do counts[e.mode] = counts[e.mode] + 1 end
+  return counts
+end
+
+local function fracture_test(name, sign, rate)
+  local r = run_test("fracture", name, {0, 0, sign * rate}, {
+    value = function(row) return row.axial_stress end,
+    stop = function(row, peak)
+      return (math.abs(row.axial_stress) < P.stop_fraction * peak and peak > 0 and row.broken_bonds > 0)
+             or math.abs(row.axial_strain) >= P.max_strain
+    end})
+  local s = r.series
+  s:plot{file = out .. "/" .. name .. ".png", x = "axial_strain", y = {"axial_stress"},
+         title = ("%s: peak %.4g Pa"):format(name, r.peak)}
+  local counts = break_map(r.world, name, ("%s: broken bonds at the end (%d)"):format(name, r.world:break_count()))
+  log("%-20s strength %.4g Pa at strain %.3g; %d bonds broken (tension %d, shear %d, compression %d)  [%d steps, %.1f s]",
+      name, r.peak, r.peak_row.axial_strain, r.world:break_count(), counts.tension, counts.shear,
+      counts.compression, r.steps, r.seconds)
+  return {strength_pa = r.peak, strain_at_peak = r.peak_row.axial_strain, broken_bonds = r.world:break_count(),
+          breaks = counts, steps = r.steps, seconds = r.seconds}
+end
+
+if want.compression or want.tension then
+  local wf, finfo = timed("bond_relax_fracture", bonded, with(bond_material, {tensile_strength = P.tensile_strength}))
+  log("fracture model: st = %.4g Pa, %d bonds, %d broken during the relaxation", P.tensile_strength, finfo.bonds,
+      finfo.broken_in_relaxation)
+  prepare(wf, "fracture")
+  wf = nil
+  collectgarbage()
+  fracture = {relaxation = finfo}
+  if want.compression then
+    timed("fracture_compression", function() fracture.compression = fracture_test("fracture_compression", -1, P.rate) end)
+  end
+  if want.tension then
+    timed("fracture_tension", function() fracture.tension = fracture_test("fracture_tension", 1, P.rate) end)
+  end
+end
+
+-- Quasi-static check: the same tests at half the rate.
+local rate_check
+if P.rate_check then
+  local half = P.rate / 2
+  local t = asperity.wall_time()
+  local saved = P.rate
+  P.rate = half
+  local c = elastic_axial("elastic_compression_half_rate", -1)
+  local sh
+  if P.shear then
+    local r = run_test("elastic", "shear_half_rate", {half, 0, 0}, {
+      value = function(row) return row.shear_stress end,
+      stop = function(row) return math.abs(row.shear_strain_layers) >= P.elastic_strain end})
+    sh = fit(r.series, "shear_strain", "shear_stress", "shear_strain_layers")
+  end
+  local fc, ft
+  if P.fracture then
+    fc = fracture_test("fracture_compression_half_rate", -1, half)
+    ft = fracture_test("fracture_tension_half_rate", 1, half)
+  end
+  P.rate = saved
+  local function rel(a, b) return b and a and (a - b) / b or nil end
+  rate_check = {rate = half,
+                young_modulus_change = rel(c.young_modulus_pa, elastic.compression.young_modulus_pa),
+                poisson_ratio_change = rel(c.poisson_ratio, elastic.compression.poisson_ratio),
+                shear_modulus_change = shear and rel(sh, shear.shear_modulus_pa),
+                compressive_strength_change = fc and rel(fc.strength_pa, fracture.compression.strength_pa),
+                tensile_strength_change = ft and rel(ft.strength_pa, fracture.tension.strength_pa),
+                seconds = asperity.wall_time() - t}
+  log("half rate: relative changes E %.2g, nu %.2g, G %s, sc %s, st %s", rate_check.young_modulus_change,
+      rate_check.poisson_ratio_change, tostring(rate_check.shear_modulus_change),
+      tostring(rate_check.compressive_strength_change), tostring(rate_check.tensile_strength_change))
+end
+
+-- Summary ---------------------------------------------------------------------------------------------
+local scale = mat.rock.young_modulus / E
+local summary = {
+  n_particles = packing.n_particles, porosity_nominal = packing.porosity_nominal,
+  porosity_true = packing.porosity_true, mean_radius_m = packing.mean_radius,
+  radius_dispersion = packing.radius_stats.dispersion, coordination_packed = packing.coordination,
+  wall_stress_pa = packing.wall_stress_pa, wall_stress_expanded_pa = packing.wall_stress_expanded_pa,
+  packing_steps = packing.expansion.steps, packing_stress_target_pa = P.packing_stress,
+  radius_factor_stress_installation = packing.stress_installation and packing.stress_installation.factor or 1,
+  bonds = elastic_info.bonds, bonds_per_particle = 2 * elastic_info.bonds / packing.n_particles,
+  residual_bond_stress = residual,
+  young_modulus_pa = E, poisson_ratio = nu,
+  young_modulus_slab_pa = E_slab, poisson_ratio_slab = nu_slab,
+  shear_modulus_isotropic_pa = E / (2 * (1 + nu)),
+  shear_modulus_isotropic_slab_pa = E_slab / (2 * (1 + nu_slab)),
+  elastic = elastic, shear = shear,
+  stress_scale = scale, young_modulus_rock_pa = mat.rock.young_modulus,
+  bond_tensile_strength_pa = P.tensile_strength,
+  rate_m_per_s = P.rate, dt_s = nil, rate_check = rate_check,
+  parameters = P, timings_s = timings,
+}
+if shear then
+  summary.shear_modulus_pa = shear.shear_modulus_pa
+  summary.shear_modulus_layers_pa = shear.shear_modulus_layers_pa
+  summary.shear_modulus_symmetric_pa = shear.shear_modulus_symmetric_pa
+  summary.isotropy_error = shear.shear_modulus_pa / summary.shear_modulus_isotropic_pa - 1
+  summary.isotropy_error_symmetric = shear.shear_modulus_symmetric_pa / summary.shear_modulus_isotropic_slab_pa - 1
+end
+if fracture then
+  summary.fracture = fracture
+  summary.compressive_strength_pa = fracture.compression.strength_pa
+  summary.tensile_strength_pa = fracture.tension.strength_pa
+  summary.compressive_strength_mpa = fracture.compression.strength_pa * scale / 1e6
+  summary.tensile_strength_mpa = fracture.tension.strength_pa * scale / 1e6
+  summary.strength_ratio = fracture.compression.strength_pa / fracture.tension.strength_pa
+  summary.broken_in_relaxation = fracture.relaxation.broken_in_relaxation
+end
+summary.seconds = asperity.wall_time() - clock0
+asperity.write_json(out .. "/summary.json", summary)
+log("E = %.4g Pa, nu = %.3f, G = %s Pa (E/2(1+nu) = %.4g), scale %.4g", E, nu,
+    shear and ("%.4g"):format(shear.shear_modulus_pa) or "-", summary.shear_modulus_isotropic_pa, scale)
+if fracture then
+  log("sc = %.4g Pa = %.2f MPa, st = %.4g Pa = %.2f MPa, ratio %.2f", summary.compressive_strength_pa,
+      summary.compressive_strength_mpa, summary.tensile_strength_pa, summary.tensile_strength_mpa,
+      summary.strength_ratio)
+end
+log("wrote %s/summary.json (%.0f s)", out, summary.seconds)
