@@ -25,7 +25,7 @@ local pack = require("pack")
 local heightmap = require("heightmap")
 
 local P = require("params").defaults{
-  surface = "S1",          -- S1..S8 (scenarios / surfaces.md table 4)
+  surface = "S1",          -- S1..S8 (surfaces.md table 4), or "flat" (a plane: the control case)
   surface_file = "",       -- or an HDF5 height map (dataset `height`, attribute `spacing`)
   scale = "",              -- "thesis": size 0.1 m (about 110 000 particles)
   size = 0.02,             -- side of the square joint, m
@@ -38,11 +38,12 @@ local P = require("params").defaults{
   velocity = 3e-5,         -- shear velocity, m/s
   normal_control = "load", -- load: constant applied force on a free platen (dead load); servo
   closure_velocity = 6e-5, -- m/s [thesis 4.2.2]
-  approach_velocity = 1e-3,-- m/s, until the first contact between the halves
+  approach_gap = 0.2e-3,    -- m, smallest gap left between the halves after lowering the upper one
   gap = 1e-3,              -- m, between the halves while they relax
   platen = 1.5e-3,         -- m, layer of each outer face that forms a platen
   porosity = 0.51,
   seed = 1,
+  pack_steps = 300000,     -- most steps spent cycling the packing towards the ratio 1e-4
   record = 0.01,           -- mm of shear between records
   snapshots = "0,1,2.5,5", -- mm of shear
   band = 0,                -- surface vs porosity band, m (0: mean radius)
@@ -69,6 +70,10 @@ local n = 2 * math.floor(P.size / P.spacing / 2) + 1     -- odd grid
 local map
 if P.surface_file ~= "" then
   map = asperity.surface.load(P.surface_file)
+elseif P.surface == "flat" then
+  local zeros = {}
+  for k = 1, n * n do zeros[k] = 0.0 end
+  map = asperity.surface.height_map{heights = zeros, spacing = P.spacing, nx = n}
 else
   map = asperity.surface.generate{name = P.surface, n = n, side = n * P.spacing, seed = P.seed}
 end
@@ -89,11 +94,11 @@ for _, z in ipairs(heights) do zmin, zmax = math.min(zmin, z), math.max(zmax, z)
 local T = P.thickness
 
 -- 2. The specimen: packed, bonded, relaxed halves (cached) ---------------------------------
-local key = ("%s_%s_n%d_h%.6g_T%.6g_p%.4g_s%d_g%.6g"):format(
-  P.surface_file ~= "" and P.surface_file:gsub("[^%w]", "_") or P.surface, "v1", n, h, T,
-  P.porosity, P.seed, P.gap)
+local key = ("%s_%s_n%d_h%.6g_T%.6g_p%.4g_s%d_g%.6g_k%d"):format(
+  P.surface_file ~= "" and P.surface_file:gsub("[^%w]", "_") or P.surface, "v2", n, h, T,
+  P.porosity, P.seed, P.gap, P.pack_steps)
 local cache_file = P.cache .. "/joint_" .. key .. ".h5"
-local LOWER, UPPER, POROSITY = 1, 2, 1
+local LOWER, UPPER, LOST, POROSITY = 1, 2, 3, 1   -- tags; POROSITY is a flag bit
 
 local function build_specimen()
   local w = asperity.world{material = mat.contact, damping = mat.damping, density = mat.density,
@@ -118,24 +123,50 @@ local function build_specimen()
   log("packing %d particles in two halves of %.1f x %.1f mm (surface %s, %d x %d grid)", count,
       Lx * 1e3, Ly * 1e3, P.surface_file ~= "" and P.surface_file or P.surface, nx, ny)
   local packed = pack.expand(w, {min = {0, 0, -T}, max = {Lx, Ly, T}, radii = r, seed = P.seed,
-                                 volume = volume, progress = P.progress,
+                                 volume = volume, progress = P.progress, max_steps = P.pack_steps,
                                  inside = function(x, y, z, rad)
                                    local s = surface_z(x, y)
                                    return z + rad < s - rad or z - rad > s + rad
                                  end})
-  log("packed in %d steps (%.0f s): porosity %.3f nominal, %.3f true", packed.steps,
-      packed.seconds, packed.porosity_nominal, packed.porosity_true)
-  -- Halves by side of the mould; tags 1 (lower) and 2 (upper).
+  log("packed in %d steps (%.0f s): porosity %.3f nominal, %.3f true; unbalanced-force ratio %.2g%s",
+      packed.steps, packed.seconds, packed.porosity_nominal, packed.porosity_true, packed.ratio,
+      packed.reached and "" or (" (not below 1e-4 within pack_steps = %d)"):format(P.pack_steps))
+  -- Halves by side of the mould; tags 1 (lower) and 2 (upper). A particle squeezed out of the
+  -- box during the expansion (a small one between two growing ones can be shot through a wall)
+  -- belongs to neither half.
   local pos = w:positions()
-  local lower, upper = {}, {}
+  local lower, upper, lost = {}, {}, {}
+  local slack = 1e-9
   for id = 1, w:particle_count() do
     local p = pos[id]
-    if p[3] < surface_z(p[1], p[2]) then lower[#lower + 1] = id else upper[#upper + 1] = id end
+    if p[1] < -slack or p[1] > Lx + slack or p[2] < -slack or p[2] > Ly + slack
+       or p[3] < -T - slack or p[3] > T + slack then
+      lost[#lost + 1] = id
+    elseif p[3] < surface_z(p[1], p[2]) then lower[#lower + 1] = id else upper[#upper + 1] = id end
   end
   w:set_tag(lower, LOWER)
   w:set_tag(upper, UPPER)
   -- Bond each half on its own (never across the mould), unbreakable while prepared.
   local bonds = w:install_bonds{breakable = false, ids = lower} + w:install_bonds{breakable = false, ids = upper}
+  -- Floaters: particles of a half without a bond carry nothing and would drift off once the
+  -- walls go. Lost particles and floaters are made inert (neither integrated nor searched) and
+  -- tagged LOST, so no half, platen or measure counts them.
+  local bonded = {}
+  for _, b in ipairs(w:bonds()) do bonded[b.a], bonded[b.b] = true, true end
+  local function keep(list)
+    local kept = {}
+    for _, id in ipairs(list) do
+      if bonded[id] then kept[#kept + 1] = id else lost[#lost + 1] = id end
+    end
+    return kept
+  end
+  lower, upper = keep(lower), keep(upper)
+  if #lost > 0 then
+    w:set_tag(lost, LOST)
+    w:add_group(lost, {translation = "fixed"})   -- inert particles must belong to a rigid body
+    w:set_inert(lost)
+    log("%d particles left out (outside the box after packing, or without a bond)", #lost)
+  end
   -- Remove the walls, part the halves by `gap`, relax [scenarios.md 3.3].
   for _, p in ipairs(planes) do w:remove_wall(p) end
   w:remove_wall(mould)
@@ -148,7 +179,7 @@ local function build_specimen()
   log("bonded (%d bonds), walls removed, relaxed in %d steps (%s)", bonds, steps, why)
   w:save(cache_file)
   asperity.write_json(cache_file .. ".json", {particles = w:particle_count(), lower = #lower,
-    upper = #upper, bonds = bonds, porosity_nominal = packed.porosity_nominal,
+    upper = #upper, left_out = #lost, bonds = bonds, porosity_nominal = packed.porosity_nominal,
     porosity_true = packed.porosity_true, packing_steps = packed.steps, relax_steps = steps,
     packing_seconds = packed.seconds})
   return w
@@ -173,7 +204,10 @@ end)()
 
 local N = world:particle_count()
 local lower, upper = {}, {}
-for id = 1, N do if world:tag(id) == LOWER then lower[#lower + 1] = id else upper[#upper + 1] = id end end
+for id = 1, N do
+  local t = world:tag(id)
+  if t == LOWER then lower[#lower + 1] = id elseif t == UPPER then upper[#upper + 1] = id end
+end
 
 -- 3. The DEM surfaces: profilometer, mean plane, surface vs porosity particles ---------------
 local pos, rad = world:positions(), world:radii()
@@ -194,16 +228,41 @@ log("DEM surface: mean plane dv = %.3g mm, %.0f %% of nodes coinciding; %.0f %% 
     "profilometer particles are on the expected surface", plane_lower.shift * 1e3,
     100 * plane_lower.coinciding_fraction, 100 * cls.retained_fraction)
 
+-- Bring the upper half down as a whole (positions only, no dynamics) until the smallest vertical
+-- gap between the two DEM surfaces is `approach_gap`; the assembly below closes the rest slowly.
+-- Driving a bonded half at speed into the other instead would send a stress wave through the
+-- specimen larger than the target stress of the soft model.
+do
+  local lo_s, up_s = prof_lower.surface, prof_upper.surface
+  local gap_min = math.huge
+  for j = 1, ny do
+    for i = 1, nx do
+      local d = up_s:at(i, j) - lo_s:at(i, j)
+      if d == d then gap_min = math.min(gap_min, d) end
+    end
+  end
+  if gap_min < math.huge and gap_min > P.approach_gap then
+    local dz = gap_min - P.approach_gap
+    for _, id in ipairs(upper) do
+      local p = pos[id]
+      world:set_position(id, {p[1], p[2], p[3] - dz})
+    end
+    pos = world:positions()
+    prof_upper = asperity.surface.profilometer{positions = pos, radii = rad, grid = map,
+                                               side = "upper", ids = upper, origin = {0, 0}}
+    log("upper half lowered by %.3f mm (smallest gap %.3f mm)", dz * 1e3, P.approach_gap * 1e3)
+  end
+end
+
 -- 4. The model, platens ----------------------------------------------------------------------
 local area = Lx * Ly
 local stress_scale = mat.rock.young_modulus / mat.rev.young_modulus    -- [3-37]
 local target_stress = P.stress * 1e6 / stress_scale                   -- model units, Pa
 local function mpa(sigma) return sigma * stress_scale / 1e6 end
+-- Outer faces of the specimen: the lowest point of the lower half, the highest of the upper.
 local zlo, zhi = math.huge, -math.huge
-for id = 1, N do
-  local z = pos[id][3]
-  zlo, zhi = math.min(zlo, z), math.max(zhi, z)
-end
+for _, id in ipairs(lower) do zlo = math.min(zlo, pos[id][3]) end
+for _, id in ipairs(upper) do zhi = math.max(zhi, pos[id][3]) end
 local bottom, top
 if P.model == "rigid" then
   world:remove_bonds()
@@ -235,7 +294,7 @@ if P.model == "rigid" then
     local p = pos[id]
     if p[3] - rad[id] > local_extreme(up_s, p[1], p[2], true) + reach then inert[#inert + 1] = id end
   end
-  world:set_inert(inert)
+  if #inert > 0 then world:set_inert(inert) end
   log("rigid model: %d of %d particles inert", #inert, N)
 else
   if P.model == "elastic" then
@@ -244,18 +303,15 @@ else
     world:set_bond_strength{tensile_strength = mat.rev.bond_tensile_strength}
   end
   local bottom_ids, top_ids = {}, {}
-  for id = 1, N do
-    local z = pos[id][3]
-    if z < zlo + P.platen then bottom_ids[#bottom_ids + 1] = id end
-    if z > zhi - P.platen then top_ids[#top_ids + 1] = id end
-  end
+  for _, id in ipairs(lower) do if pos[id][3] < zlo + P.platen then bottom_ids[#bottom_ids + 1] = id end end
+  for _, id in ipairs(upper) do if pos[id][3] > zhi - P.platen then top_ids[#top_ids + 1] = id end end
   bottom = world:add_group(bottom_ids, {translation = "fixed"})
   top = world:add_group(top_ids, {translation = {"fixed", "fixed", "velocity"}, velocity = {0, 0, 0}})
 end
 
 -- 5. Assembly: bring the halves together until exactly one contact exists [4.2.1] ------------
 local function between() return world:contact_summary(LOWER, UPPER, POROSITY) end
-world:set_group_motion(top, {velocity = {0, 0, -P.approach_velocity}})
+world:set_group_motion(top, {velocity = {0, 0, -P.closure_velocity}})
 local steps = world:run{steps = 10000000, every = 1, progress = P.progress,
                         stop_when = function(w) return w:contact_summary(LOWER, UPPER).count >= 1 end}
 world:set_group_motion(top, {velocity = {0, 0, 0}})
@@ -284,7 +340,12 @@ world:set_group_motion(top, {velocity = {0, 0, -P.closure_velocity}})
 record_closure()
 world:run{steps = 10000000, every = 1, progress = P.progress,
           callback = function(w) if w:step() % 500 == 0 then record_closure() end end,
-          stop_when = function() return normal_stress() >= target_stress end}
+          stop_when = function() return normal_stress() >= target_stress end,
+          fraction = function() return normal_stress() / target_stress end,
+          show = function()
+            return {closure_um = 1e6 * (z_contact - world:group_position(top)[3]),
+                    sigma_mpa = mpa(normal_stress()), contacts = between().count}
+          end}
 record_closure()
 log("closed to %.3g MPa in %.1f um", mpa(normal_stress()), 1e6 * (z_contact - world:group_position(top)[3]))
 closure:write(P.out .. "/closure")
@@ -336,7 +397,7 @@ do
   world:set_group_motion(top, {translation = modes, velocity = shear_velocity})
 end
 local shear = asperity.series{"displacement [mm]", "shear_stress [Pa]", "shear_stress_mpa [MPa]",
-  "normal_stress_mpa [MPa]", "dilatancy [mm]", "contacts [1]", "contact_area [%]",
+  "normal_stress_mpa [MPa]", "normal_stress_mean_mpa [MPa]", "dilatancy [mm]", "contacts [1]", "contact_area [%]",
   "broken_bonds [1]", "porosity_shear_stress_mpa [MPa]", "kinetic [J]", "strain [J]",
   "friction [J]", "damping [J]", "released [J]", "boundary_work [J]", "shear_work [J]",
   "dilatancy_work [J]", "time [s]"}
@@ -350,8 +411,17 @@ for v in P.snapshots:gmatch("[^,]+") do snap_at[#snap_at + 1] = tonumber(v) end
 local next_snap = 1
 local contact_points = {}
 local function displacement() return (c0[axis] - world:group_position(top)[axis]) * 1e3 end
+-- The normal stress averaged over each recording interval (sampled every step), as a load cell
+-- with a low-pass filter reads it: the instantaneous value also carries the platen's inertia at
+-- each slip event of the soft model.
+local sn_sum, sn_count = 0, 0
+local function sample_normal()
+  sn_sum, sn_count = sn_sum + normal_stress(), sn_count + 1
+end
 local function record_shear()
   local p, f = world:group_position(top), platen_force()
+  local sn_mean = sn_count > 0 and sn_sum / sn_count or f[3] / area
+  sn_sum, sn_count = 0, 0
   -- Work of the agent on the specimen: the force it applies is minus the particles' force.
   shear_work = shear_work - 0.5 * (f[axis] + last_force[axis]) * (p[axis] - last_pos[axis])
   dilatancy_work = dilatancy_work - 0.5 * (f[3] + last_force[3]) * (p[3] - last_pos[3])
@@ -359,7 +429,7 @@ local function record_shear()
   local c = between()
   local tau = f[axis] / area   -- the lower half resists the upper one moving along -axis
   local e = world:energies()
-  shear:record(displacement(), tau, mpa(tau), mpa(f[3] / area), (p[3] - c0[3]) * 1e3, c.count,
+  shear:record(displacement(), tau, mpa(tau), mpa(f[3] / area), mpa(sn_mean), (p[3] - c0[3]) * 1e3, c.count,
                100 * c.area / area, world:break_count(), mpa(c.flagged_force[axis] / area),
                e.kinetic, e.strain - e0.strain, e.friction - e0.friction, e.damping - e0.damping,
                e.released - e0.released, e.boundary_work - e0.boundary_work, shear_work,
@@ -377,8 +447,12 @@ end
 record_shear()
 local record_every = math.max(1, math.floor(P.record * 1e-3 / (P.velocity * world:dt()) + 0.5))
 world:run{steps = 100000000, every = 1, progress = P.progress,
-          callback = function(w) if w:step() % record_every == 0 then record_shear() end end,
+          callback = function(w)
+            sample_normal()
+            if w:step() % record_every == 0 then record_shear() end
+          end,
           stop_when = function() return displacement() >= P.shear end,
+          fraction = function() return displacement() / P.shear end,
           show = function()
             return {disp_mm = displacement(), tau_mpa = mpa(platen_force()[axis] / area),
                     sigma_mpa = mpa(normal_stress())}
@@ -415,15 +489,22 @@ for k = cat, rows do
   if u[k] > 0 and cnt[k] > 0 then lx[#lx + 1] = math.log(u[k]); ly[#ly + 1] = math.log(cnt[k]) end
 end
 local q = fit(lx, ly)
-local sn_dev = 0
-for k = 1, rows do if u[k] > 0.05 then sn_dev = math.max(sn_dev, math.abs(sn[k] / P.stress - 1)) end end
+local sn_mean = shear:column("normal_stress_mean_mpa")
+local sn_dev, sn_dev_mean = 0, 0
+for k = 1, rows do
+  if u[k] > 0.05 then
+    sn_dev = math.max(sn_dev, math.abs(sn[k] / P.stress - 1))
+    sn_dev_mean = math.max(sn_dev_mean, math.abs(sn_mean[k] / P.stress - 1))
+  end
+end
 local e = world:energies()
 local input = e.boundary_work - e0.boundary_work
 local function share(v) return input ~= 0 and v / input or 0/0 end
 local summary = {
   parameters = P,
   surface = {nx = nx, ny = ny, spacing = h, side_x = Lx, side_y = Ly},
-  n_particles = N,
+  n_particles = #lower + #upper,
+  left_out_particles = N - #lower - #upper,
   n_lower = #lower,
   n_upper = #upper,
   inert_particles = world:inert_count(),
@@ -437,7 +518,8 @@ local summary = {
   max_dilatancy_mm = max_dil,
   dilatancy_angle_at_peak_deg = math.deg(math.atan(slope_at(at))),
   normal_stiffness_mpa_per_mm = normal_stiffness,
-  normal_stress_max_deviation = sn_dev,
+  normal_stress_max_deviation = sn_dev_mean,          -- of the interval means (after 0.05 mm)
+  normal_stress_max_deviation_instant = sn_dev,       -- of the values at the recorded steps
   broken_bonds = world:break_count(),
   contact_decay_exponent = q,
   max_contacts = cmax,
@@ -505,4 +587,6 @@ end)
 
 print(("%s %s %g MPa -%s: %d particles, peak %.2f MPa at %.2f mm, residual %.2f MPa, " ..
        "max dilatancy %.3f mm, %d broken bonds, %.0f s"):format(P.surface, P.model, P.stress,
-  P.direction, N, peak, u[at], residual, max_dil, world:break_count(), summary.wall_seconds))
+  P.direction, summary.n_particles, peak, u[at], residual, max_dil, world:break_count(),
+  summary.wall_seconds))
+return summary   -- for scripts that run this one with dofile (tests, the study)

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include "lua/progress.hpp"
 
 #include <sys/ioctl.h>
@@ -46,7 +47,7 @@ bool Progress::due() {
          (!drawn_ || std::chrono::duration<double>(now - last_).count() >= kInterval);
 }
 
-void Progress::draw(std::uint64_t done, const std::string& extra) {
+void Progress::draw(std::uint64_t done, const std::string& extra, double fraction) {
   auto now = Clock::now();
   double since_last = std::chrono::duration<double>(now - last_).count();
   double instant = since_last > 0 ? double(done - last_done_) / since_last : 0;
@@ -58,7 +59,16 @@ void Progress::draw(std::uint64_t done, const std::string& extra) {
 
   std::string line;
   char buf[96];
-  if (total_) {
+  double elapsed = std::chrono::duration<double>(now - start_).count();
+  const bool by_fraction = fraction >= 0;
+  if (by_fraction) {
+    const double f = std::min(fraction, 1.0);
+    int width = 20, filled = static_cast<int>(f * width);
+    line = "[" + std::string(static_cast<std::size_t>(filled), '#') +
+           std::string(static_cast<std::size_t>(width - filled), '-') + "]";
+    std::snprintf(buf, sizeof buf, " %5.1f%%  step %llu", 100 * f, (unsigned long long)done);
+    line += buf;
+  } else if (total_) {
     double f = double(done) / double(total_);
     int width = 20, filled = static_cast<int>(f * width);
     line = "[" + std::string(static_cast<std::size_t>(filled), '#') +
@@ -71,9 +81,11 @@ void Progress::draw(std::uint64_t done, const std::string& extra) {
     line = buf;
   }
   line += "  " + rate_text(rate_) + " steps/s";
-  double elapsed = std::chrono::duration<double>(now - start_).count();
   line += "  " + duration_text(elapsed);
-  if (total_ && rate_ > 0) line += "  ETA " + duration_text(double(total_ - done) / rate_);
+  if (by_fraction && fraction > 0)
+    line += "  ETA " + duration_text(elapsed * (1 - std::min(fraction, 1.0)) / fraction);
+  else if (!by_fraction && total_ && rate_ > 0)
+    line += "  ETA " + duration_text(double(total_ - done) / rate_);
   if (!extra.empty()) line += "  " + extra;
   winsize ws{};
   if (::ioctl(STDERR_FILENO, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 1 && line.size() >= ws.ws_col)

@@ -17,7 +17,9 @@ class Progress {
   ~Progress();  // erases the line (an error is on its way)
   // Whether a redraw is due now (cheap: one clock read).
   bool due();
-  void draw(std::uint64_t done, const std::string& extra);
+  // `fraction` in [0, 1] (the script's own measure of completion, e.g. sheared / target
+  // displacement) replaces done / total when given (>= 0).
+  void draw(std::uint64_t done, const std::string& extra, double fraction = -1);
   // Replaces the line by a one-line summary (if anything was drawn).
   void finish(std::uint64_t done, const std::string& reason);
 

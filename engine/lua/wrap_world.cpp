@@ -950,6 +950,8 @@ int world_run(lua_State* L) {
     bool progress = o.boolean("progress", true);
     int show_type = o.push_checked("show", LUA_TFUNCTION, "a function(world) returning a string or table");
     int show = lua_gettop(L);
+    int fraction_type = o.push_checked("fraction", LUA_TFUNCTION, "a function(world) returning 0..1");
+    int fraction_fn = lua_gettop(L);
     o.finish();
     if (steps == 0 && stop_type == LUA_TNIL)
       throw Error(ctx + ": give steps = (how many) and/or stop_when = (a function or \"equilibrium\")");
@@ -1002,7 +1004,13 @@ int world_run(lua_State* L) {
           std::string s = show_text(L, show);
           if (!s.empty()) extra += (extra.empty() ? "" : "  ") + s;
         }
-        bar.draw(done, extra);
+        double fraction = -1;
+        if (fraction_type != LUA_TNIL) {
+          call_with_world(L, fraction_fn, 1);
+          fraction = lua_isnumber(L, -1) ? std::max(0.0, static_cast<double>(lua_tonumber(L, -1))) : -1;
+          lua_pop(L, 1);
+        }
+        bar.draw(done, extra, fraction);
       }
     }
     bar.finish(done, reason);
@@ -1270,13 +1278,15 @@ void open_world(lua_State* L) {
       {"cycle", world_cycle, "world:cycle([n]) -> steps",
        "Advances n steps (1). Ctrl-C stops it at the next step with an 'interrupted' error."},
       {"run", world_run,
-       "world:run{steps= [, stop_when=] [, ratio=] [, every=] [, callback=] [, progress=] [, show=]}\n"
+       "world:run{steps= [, stop_when=] [, ratio=] [, every=] [, callback=] [, progress=] [, show=]\n"
+       "          [, fraction=]}\n"
        "  -> steps, reason",
        "Runs up to `steps` steps, or until stop_when: a function(world) returning true, or\n"
        "\"equilibrium\" (unbalanced-force ratio <= ratio, default 1e-4). stop_when and\n"
        "callback(world) are evaluated every `every` steps (100). A progress line appears on a\n"
        "terminal after 2 s (progress=false: never); show(world) returns a string or a table of\n"
-       "values to add to it. reason: \"steps\", \"equilibrium\" or \"stop_when\"."},
+       "values to add to it; fraction(world) returns the completion 0..1 for the percent and ETA\n"
+       "when stop_when, not steps, ends the run. reason: \"steps\", \"equilibrium\" or \"stop_when\"."},
       {"dt", world_dt, "world:dt() -> s", "The time step in use."},
       {"set_dt", world_set_dt, "world:set_dt(dt)", "Fixes the time step (0: automatic again)."},
       {"critical_dt", world_critical_dt, "world:critical_dt() -> s",
