@@ -376,17 +376,15 @@ if P.rate_check then
   P.rate = half
   local c = elastic_axial("elastic_compression_half_rate", -1)
   local sh
-  if P.shear then
+  if want.shear then
     local r = run_test("elastic", "shear_half_rate", {half, 0, 0}, {
       value = function(row) return row.shear_stress end,
       stop = function(row) return math.abs(row.shear_strain_layers) >= P.elastic_strain end})
     sh = fit(r.series, "shear_strain", "shear_stress", "shear_strain_layers")
   end
   local fc, ft
-  if P.fracture then
-    fc = fracture_test("fracture_compression_half_rate", -1, half)
-    ft = fracture_test("fracture_tension_half_rate", 1, half)
-  end
+  if want.compression then fc = fracture_test("fracture_compression_half_rate", -1, half) end
+  if want.tension then ft = fracture_test("fracture_tension_half_rate", 1, half) end
   P.rate = saved
   local function rel(a, b) return b and a and (a - b) / b or nil end
   rate_check = {rate = half,
@@ -431,11 +429,18 @@ if shear then
 end
 if fracture then
   summary.fracture = fracture
-  summary.compressive_strength_pa = fracture.compression.strength_pa
-  summary.tensile_strength_pa = fracture.tension.strength_pa
-  summary.compressive_strength_mpa = fracture.compression.strength_pa * scale / 1e6
-  summary.tensile_strength_mpa = fracture.tension.strength_pa * scale / 1e6
-  summary.strength_ratio = fracture.compression.strength_pa / fracture.tension.strength_pa
+  -- Either test may have been left out (tests=...).
+  if fracture.compression then
+    summary.compressive_strength_pa = fracture.compression.strength_pa
+    summary.compressive_strength_mpa = fracture.compression.strength_pa * scale / 1e6
+  end
+  if fracture.tension then
+    summary.tensile_strength_pa = fracture.tension.strength_pa
+    summary.tensile_strength_mpa = fracture.tension.strength_pa * scale / 1e6
+  end
+  if fracture.compression and fracture.tension then
+    summary.strength_ratio = fracture.compression.strength_pa / fracture.tension.strength_pa
+  end
   summary.broken_in_relaxation = fracture.relaxation.broken_in_relaxation
 end
 summary.seconds = asperity.wall_time() - clock0
@@ -443,8 +448,10 @@ asperity.write_json(out .. "/summary.json", summary)
 log("E = %.4g Pa, nu = %.3f, G = %s Pa (E/2(1+nu) = %.4g), scale %.4g", E, nu,
     shear and ("%.4g"):format(shear.shear_modulus_pa) or "-", summary.shear_modulus_isotropic_pa, scale)
 if fracture then
-  log("sc = %.4g Pa = %.2f MPa, st = %.4g Pa = %.2f MPa, ratio %.2f", summary.compressive_strength_pa,
-      summary.compressive_strength_mpa, summary.tensile_strength_pa, summary.tensile_strength_mpa,
-      summary.strength_ratio)
+  local function v(x, fmt) return x and (fmt):format(x) or "-" end
+  log("sc = %s Pa = %s MPa, st = %s Pa = %s MPa, ratio %s", v(summary.compressive_strength_pa, "%.4g"),
+      v(summary.compressive_strength_mpa, "%.2f"), v(summary.tensile_strength_pa, "%.4g"),
+      v(summary.tensile_strength_mpa, "%.2f"), v(summary.strength_ratio, "%.2f"))
 end
 log("wrote %s/summary.json (%.0f s)", out, summary.seconds)
+return summary   -- for scripts that run this one with dofile (calibrate_rev.lua)
