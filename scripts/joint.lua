@@ -300,7 +300,22 @@ else
   if P.model == "elastic" then
     world:set_bond_strength{breakable = false}
   else
-    world:set_bond_strength{tensile_strength = mat.rev.bond_tensile_strength}
+    -- The bonds must hold what the preparation locked into them, or the "fracture" model is an
+    -- unbonded pile that collapses at the first step. Say so instead of shearing it.
+    local st = mat.rev.bond_tensile_strength
+    local over, worst, all = 0, 0, world:bonds()
+    for _, b in ipairs(all) do
+      local need = mat.strength_to_hold(b.sigma, b.tau)
+      if need > st then over = over + 1 end
+      worst = math.max(worst, need)
+    end
+    if over > 0.01 * #all then
+      error(("model=fracture: %d of %d bonds (%.0f %%) of the prepared specimen carry stresses that need " ..
+             "a strength above the calibrated st = %.4g Pa (largest %.4g Pa): the packing locked more " ..
+             "stress into the halves than the REV's. Run model=elastic or rigid, or give a specimen " ..
+             "prepared at a lower stress."):format(over, #all, 100 * over / #all, st, worst), 0)
+    end
+    world:set_bond_strength{tensile_strength = st}
   end
   local bottom_ids, top_ids = {}, {}
   for _, id in ipairs(lower) do if pos[id][3] < zlo + P.platen then bottom_ids[#bottom_ids + 1] = id end end
