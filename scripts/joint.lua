@@ -1,7 +1,7 @@
 -- A rock joint closed and sheared under constant normal load (scenarios.md 3-6, surfaces.md 3).
 --
 --   build/asperity run scripts/joint.lua                              -- the default small joint
---   build/asperity run scripts/joint.lua surface=S5 model=fracture stress=21 direction=y
+--   build/asperity run scripts/joint.lua surface=S5 model=rigid stress=21 direction=y
 --   build/asperity run scripts/joint.lua scale=thesis                 -- 10 cm x 10 cm
 --
 -- Steps: generate (or load) the surface; mould it as a triangle mesh between two boxes of plane
@@ -9,12 +9,15 @@
 -- (unbreakable while prepared); remove the walls, part the halves by `gap` and relax them; cache
 -- the result on disk (keyed by everything that shaped it, so the three models and both
 -- directions reuse it); analyse the DEM surfaces (profilometer, mean plane, surface vs porosity
--- particles); then, for the chosen model, bring the halves together until one contact exists,
--- close the joint at 6e-5 m/s to the normal stress, and shear it under constant normal load.
+-- particles); then, for the chosen model, lower the upper half as a whole to `approach_gap` and
+-- bring it down at the closure velocity until one contact exists, close the joint at 6e-5 m/s to
+-- the normal stress, and shear it under constant normal load.
 --
 -- Models [scenarios.md 4]: rigid (each half one rigid body; only particles that can touch the
 -- other half are searched), elastic (unbreakable bonds), fracture (elliptic criterion with the
--- calibrated bond strength). Stresses are reported in model units and scaled to rock [3-37].
+-- calibrated bond strength; refused while the prepared halves lock more stress into their bonds
+-- than that strength, see scripts/README.md). Stresses are reported in model units and scaled to
+-- rock [3-37].
 --
 -- Writes into `out`: summary.json; closure.{h5,csv}, shear.{h5,csv}; snapshots (HDF5 + XDMF) at
 -- the displacements in `snapshots`; PNG plots: shear stress and dilatancy, closure curve, contact
@@ -194,14 +197,6 @@ if f then
 else
   world = build_specimen()
 end
-local specimen_info = (function()
-  local fh = io.open(cache_file .. ".json")
-  if not fh then return {} end
-  local text = fh:read("a")
-  fh:close()
-  return {json = text}
-end)()
-
 local N = world:particle_count()
 local lower, upper = {}, {}
 for id = 1, N do
