@@ -52,6 +52,7 @@ local P = require("params").defaults{
   tests = "elastic,shear,compression,tension",   -- which tests to run
   rate_check = false,
   lock_rotation = true,      -- model.md 2: bonded particles do not rotate
+  bond_gap = 0,              -- m, largest gap bonded (0: the engine's default, 1e-3 x mean radius)
   threads = 1,
   out = "out/rev",
 }
@@ -122,6 +123,7 @@ local function bonded(material)
 end
 
 local bond_material = {beam_kn = P.kn, beam_ks = P.ks, radius_factor = 1}
+if P.bond_gap > 0 then bond_material.tolerance = P.bond_gap end   -- else the engine's 1e-3 <R>
 local function with(t, extra)
   local c = {}
   for k, v in pairs(t) do c[k] = v end
