@@ -41,6 +41,7 @@ local P = require("params").defaults{
   velocity = 3e-5,         -- shear velocity, m/s
   normal_control = "load", -- load: constant applied force on a free platen (dead load); servo
   closure_velocity = 6e-5, -- m/s [thesis 4.2.2]
+  closure_every = 50,      -- steps between closure records (the source: 500; finer for the stiffness fit)
   approach_gap = 0.2e-3,    -- m, smallest gap left between the halves after lowering the upper one
   gap = 1e-3,              -- m, between the halves while they relax
   platen = 1.5e-3,         -- m, layer of each outer face that forms a platen
@@ -349,7 +350,7 @@ end
 world:set_group_motion(top, {velocity = {0, 0, -P.closure_velocity}})
 record_closure()
 world:run{steps = 10000000, every = 1, progress = P.progress,
-          callback = function(w) if w:step() % 500 == 0 then record_closure() end end,
+          callback = function(w) if w:step() % P.closure_every == 0 then record_closure() end end,
           stop_when = function() return normal_stress() >= target_stress end,
           fraction = function() return normal_stress() / target_stress end,
           show = function()
