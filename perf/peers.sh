@@ -128,7 +128,7 @@ busy_cores() {  # CPU time used by everything over 2 s, in cores
   read -r -a a < /proc/stat; sleep 2; read -r -a b < /proc/stat
   awk -v u="$(( (b[1]+b[2]+b[3]+b[6]+b[7]) - (a[1]+a[2]+a[3]+a[6]+a[7]) ))" \
       -v t="$(( (b[1]+b[2]+b[3]+b[4]+b[5]+b[6]+b[7]) - (a[1]+a[2]+a[3]+a[4]+a[5]+a[6]+a[7]) ))" \
-      -v c="$(getconf _NPROCESSORS_ONLN)" 'BEGIN { printf "%.2f", t > 0 ? c * u / t : 0 }'
+      -v c="$(getconf _NPROCESSORS_ONLN)" 'BEGIN { printf "%.2f", (t > 0 ? c * u / t : 0) }'
 }
 wait_quiet() {
   [[ $QUIET -gt 0 ]] || return 0

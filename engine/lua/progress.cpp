@@ -1,9 +1,9 @@
-#include <algorithm>
 #include "lua/progress.hpp"
 
 #include <sys/ioctl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 
 namespace asperity::lua {
@@ -61,18 +61,19 @@ void Progress::draw(std::uint64_t done, const std::string& extra, double fractio
   char buf[96];
   double elapsed = std::chrono::duration<double>(now - start_).count();
   const bool by_fraction = fraction >= 0;
+  auto bar = [](double f) {
+    const int width = 20, filled = static_cast<int>(f * width);
+    return "[" + std::string(static_cast<std::size_t>(filled), '#') +
+           std::string(static_cast<std::size_t>(width - filled), '-') + "]";
+  };
   if (by_fraction) {
     const double f = std::min(fraction, 1.0);
-    int width = 20, filled = static_cast<int>(f * width);
-    line = "[" + std::string(static_cast<std::size_t>(filled), '#') +
-           std::string(static_cast<std::size_t>(width - filled), '-') + "]";
+    line = bar(f);
     std::snprintf(buf, sizeof buf, " %5.1f%%  step %llu", 100 * f, (unsigned long long)done);
     line += buf;
   } else if (total_) {
     double f = double(done) / double(total_);
-    int width = 20, filled = static_cast<int>(f * width);
-    line = "[" + std::string(static_cast<std::size_t>(filled), '#') +
-           std::string(static_cast<std::size_t>(width - filled), '-') + "]";
+    line = bar(f);
     std::snprintf(buf, sizeof buf, " %5.1f%%  %llu/%llu", 100 * f, (unsigned long long)done,
                   (unsigned long long)total_);
     line += buf;
