@@ -13,6 +13,7 @@ namespace asperity::kernels {
 // Scalar twins of the xsimd functions the templates call unqualified (found by ADL for batches).
 inline double select(bool m, double a, double b) { return m ? a : b; }
 using std::sqrt;
+using std::abs;
 
 template <class T>
 struct LawParams {

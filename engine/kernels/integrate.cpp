@@ -1,7 +1,9 @@
-// Stages `gather` and `integrate`, fused: for each particle, sum its pair and wall contributions
-// in the fixed order of its incidence list, then (unless it belongs to a rigid group, which
-// bodies/groups.cpp moves) advance it with leapfrog and local damping [3-5..3-7, 3-28, 3-29].
-// Fusing saves writing the force and reading it back; the force is still stored for the API.
+// Stages `gather` and `integrate`, fused per block of kParticleBlock particles: the gather sums
+// each particle's pair, bond and wall contributions in the fixed order of its incidence lists
+// into fx..tz (scalar: the incidence lists are irregular), then the integrate kernel advances the
+// block with leapfrog and local damping (kernels/integrate_loop.hpp, SIMD; particles of rigid
+// groups are moved by bodies/groups.cpp). The block's forces are still in L1/L2 when the kernel
+// reads them back.
 //
 // Per-pair results give force and torques without anything else (model.md 4):
 //   on b: F = Fn n + Fs, torque (xc - xb) x F = -(Rb - U/2) n x Fs
@@ -11,27 +13,6 @@
 #include "state.hpp"
 
 namespace asperity::detail {
-
-namespace {
-inline double sign(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
-
-// One degree of freedom of leapfrog with local damping. Returns the new velocity; adds the work
-// of the damping force (>= 0 when dissipating) using the mean of the old and new velocities,
-// which is what makes the kinetic-energy change of a step equal the work of its forces.
-//
-// The damping force is proportional to the unbalanced force, gravity included [3-28, model.md 2:
-// "steady motion under zero net force is not damped"]: a particle resting on a floor carries
-// F = -m g from its contacts and must feel no damping. Damping |F| without gravity would push it
-// up and down by alpha g dt every step, and a pile would never reach equilibrium.
-inline double advance(double v, double f, double inv_m, double accel, double alpha, double dt,
-                      double& damping_work) {
-  const double unbalanced = f + accel / inv_m;
-  const double fd = -alpha * std::fabs(unbalanced) * sign(v);  // [3-28]: opposes the motion
-  const double vn = v + (f + fd) * inv_m * dt + accel * dt;
-  damping_work -= fd * 0.5 * (v + vn) * dt;
-  return vn;
-}
-}  // namespace
 
 void gather_and_integrate(State& s) {
   ParticleStore& p = s.p;
@@ -43,15 +24,29 @@ void gather_and_integrate(State& s) {
   const std::size_t n = p.n;
   const std::size_t blocks = (n + kParticleBlock - 1) / kParticleBlock;
   s.particle_blocks.assign(blocks, {});
-  const double dt = s.dt, alpha = s.settings.local_damping;
   const Vec3 g = s.settings.gravity;
-  const bool rotation = s.any_rotating, applied = p.has_applied;
+  const bool applied = p.has_applied;
+  const auto integrate = s.any_rotating ? s.kernels->integrate : s.kernels->integrate_norot;
+  const kernels::IntegrateArgs args{
+      p.x.data(), p.y.data(), p.z.data(), p.vx.data(), p.vy.data(), p.vz.data(),
+      p.wx.data(), p.wy.data(), p.wz.data(), p.fx.data(), p.fy.data(), p.fz.data(),
+      p.tx.data(), p.ty.data(), p.tz.data(), p.x0.data(), p.y0.data(), p.z0.data(),
+      p.mass.data(), p.inv_mass.data(), p.inertia.data(), p.inv_inertia.data(), p.radius.data(),
+      applied ? p.ax.data() : nullptr, applied ? p.ay.data() : nullptr,
+      applied ? p.az.data() : nullptr, nullptr, nullptr,
+      s.dt, s.settings.local_damping, g.x, g.y, g.z};
 
 #pragma omp parallel for schedule(static) num_threads(thread_count(s))
   for (std::size_t blk = 0; blk < blocks; ++blk) {
     ParticleBlockResult r;
-    const std::size_t end = std::min(n, (blk + 1) * kParticleBlock);
-    for (std::size_t i = blk * kParticleBlock; i < end; ++i) {
+    const std::size_t first = blk * kParticleBlock;
+    const std::size_t end = std::min(n, first + kParticleBlock);
+    // 0/1 masks for the integrate kernel; zero beyond n (padding particles are not moved).
+    alignas(64) double free[kParticleBlock] = {}, spin[kParticleBlock] = {};
+    kernels::IntegrateArgs a = args;
+    a.free = free;
+    a.spin = spin;
+    for (std::size_t i = first; i < end; ++i) {
       if (p.inert[i]) continue;  // no contacts, moved lazily with its group
       double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
       const double R = p.radius[i];
@@ -101,43 +96,18 @@ void gather_and_integrate(State& s) {
       }
       p.fx[i] = fx; p.fy[i] = fy; p.fz[i] = fz;
       p.tx[i] = tx; p.ty[i] = ty; p.tz[i] = tz;
-      if (p.group[i] >= 0) continue;  // moved with its group
-
-      const double im = p.inv_mass[i], m = p.mass[i];
-      const double vx = p.vx[i], vy = p.vy[i], vz = p.vz[i];
-      const double nvx = advance(vx, fx, im, g.x, alpha, dt, r.damping);
-      const double nvy = advance(vy, fy, im, g.y, alpha, dt, r.damping);
-      const double nvz = advance(vz, fz, im, g.z, alpha, dt, r.damping);
-      const double mvx = 0.5 * (vx + nvx), mvy = 0.5 * (vy + nvy), mvz = 0.5 * (vz + nvz);
-      r.gravity += m * (g.x * mvx + g.y * mvy + g.z * mvz) * dt;
-      if (applied) r.applied += (p.ax[i] * mvx + p.ay[i] * mvy + p.az[i] * mvz) * dt;
-      p.vx[i] = nvx; p.vy[i] = nvy; p.vz[i] = nvz;
-      p.x[i] += nvx * dt;
-      p.y[i] += nvy * dt;
-      p.z[i] += nvz * dt;
-      double kin = m * (mvx * mvx + mvy * mvy + mvz * mvz);
-      double spin = 0;
-      if (rotation && !p.rotation_locked[i]) {
-        const double ii = p.inv_inertia[i];
-        const double wx = advance(p.wx[i], tx, ii, 0.0, alpha, dt, r.damping);
-        const double wy = advance(p.wy[i], ty, ii, 0.0, alpha, dt, r.damping);
-        const double wz = advance(p.wz[i], tz, ii, 0.0, alpha, dt, r.damping);
-        const double mwx = 0.5 * (p.wx[i] + wx), mwy = 0.5 * (p.wy[i] + wy), mwz = 0.5 * (p.wz[i] + wz);
-        p.wx[i] = wx; p.wy[i] = wy; p.wz[i] = wz;
-        kin += p.inertia[i] * (mwx * mwx + mwy * mwy + mwz * mwz);
-        spin = std::sqrt(wx * wx + wy * wy + wz * wz) * dt / 0.1;
-      }
-      r.kinetic += 0.5 * kin;
-      const double dx = p.x[i] - p.x0[i], dy = p.y[i] - p.y0[i], dz = p.z[i] - p.z0[i];
-      const double d2 = dx * dx + dy * dy + dz * dz;
-      // NaN-safe comparisons: a non-finite value always becomes the block's worst.
-      if (!(d2 <= r.max_disp2)) r.max_disp2 = d2;
-      const double stepr = std::max(std::sqrt(nvx * nvx + nvy * nvy + nvz * nvz) * dt / R, spin);
-      if (!(stepr <= r.worst_step) && !(r.worst >= 0 && std::isnan(r.worst_step))) {
-        r.worst_step = stepr;
-        r.worst = std::int32_t(i);
-      }
+      free[i - first] = p.group[i] < 0 ? 1.0 : 0.0;  // else: moved with its group
+      spin[i - first] = (p.group[i] < 0 && !p.rotation_locked[i]) ? 1.0 : 0.0;
     }
+    kernels::IntegrateSums sums;
+    integrate(a, first, round_up(end, kMaxLanes), sums);
+    r.damping = sums.damping;
+    r.gravity = sums.gravity;
+    r.applied = sums.applied;
+    r.kinetic = sums.kinetic;
+    r.max_disp2 = sums.max_disp2;
+    r.worst_step = sums.worst_step;
+    r.worst = std::int32_t(sums.worst);
     s.particle_blocks[blk] = r;
   }
 }

@@ -40,6 +40,35 @@ struct BondKernelArgs {
 
 using BondKernel = double (*)(const BondKernelArgs&, std::size_t begin, std::size_t end);
 
+// Integrate kernel (integrate_loop.hpp): particles [begin, end), begin a multiple of kMaxLanes and
+// end padded up to one (the padding particles have free = 0). `free` and `spin` are 0/1 masks
+// indexed from begin; ax..az are null when no particle carries an applied force.
+struct IntegrateArgs {
+  double* x; double* y; double* z;
+  double* vx; double* vy; double* vz;
+  double* wx; double* wy; double* wz;
+  const double* fx; const double* fy; const double* fz;
+  const double* tx; const double* ty; const double* tz;
+  const double* x0; const double* y0; const double* z0;
+  const double* mass; const double* inv_mass; const double* inertia; const double* inv_inertia;
+  const double* radius;
+  const double* ax; const double* ay; const double* az;
+  const double* free; const double* spin;
+  double dt, alpha, gx, gy, gz;
+};
+
+// What a block of the integrate stage reports: energy terms of the step (summed per lane, then
+// over lanes: equal to the scalar sums to rounding), the largest squared displacement since the
+// last build, and the largest step displacement / R (or turn / 0.1 rad) with its particle index.
+struct IntegrateSums {
+  double damping = 0, gravity = 0, applied = 0, kinetic = 0;
+  double max_disp2 = 0, worst_step = 0;
+  std::int64_t worst = -1;
+};
+
+using IntegrateKernel = void (*)(const IntegrateArgs&, std::size_t begin, std::size_t end,
+                                 IntegrateSums& out);
+
 struct KernelSet {
   const char* name;        // "scalar", "sse4_2", "avx2", "avx512f"
   std::size_t lanes;       // doubles per batch
@@ -47,6 +76,8 @@ struct KernelSet {
   PairKernel pair_norot;   // every particle's rotation locked: w is not read
   BondKernel bond;
   BondKernel bond_norot;
+  IntegrateKernel integrate;        // with rotation
+  IntegrateKernel integrate_norot;  // no particle can rotate: w and torques are not read
 };
 
 const KernelSet& scalar_kernels();

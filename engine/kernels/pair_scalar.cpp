@@ -1,6 +1,7 @@
 // Scalar reference of the pair kernel: one pair at a time, plain doubles. It is the definition
 // the SIMD kernels are tested against, and what a build without SIMD runs.
 #include "kernels/bond_loop.hpp"
+#include "kernels/integrate_loop.hpp"
 #include "kernels/pair_loop.hpp"
 
 namespace asperity::kernels {
@@ -14,6 +15,8 @@ struct ScalarLanes {
   static double load(const double* p) { return *p; }
   static void store(double* p, double v) { *p = v; }
   static double sum(double v) { return v; }
+  static double iota(double start) { return start; }
+  static double lane(double v, std::size_t) { return v; }
 };
 
 double pair_rot(const PairKernelArgs& k, std::size_t b, std::size_t e) {
@@ -29,10 +32,18 @@ double bond_norot(const BondKernelArgs& k, std::size_t b, std::size_t e) {
   return bond_loop<ScalarLanes, false>(k, b, e);
 }
 
+void integrate_rot(const IntegrateArgs& k, std::size_t b, std::size_t e, IntegrateSums& out) {
+  integrate_loop<ScalarLanes, true>(k, b, e, out);
+}
+void integrate_norot(const IntegrateArgs& k, std::size_t b, std::size_t e, IntegrateSums& out) {
+  integrate_loop<ScalarLanes, false>(k, b, e, out);
+}
+
 }  // namespace
 
 const KernelSet& scalar_kernels() {
-  static const KernelSet set{"scalar", 1, &pair_rot, &pair_norot, &bond_rot, &bond_norot};
+  static const KernelSet set{"scalar", 1, &pair_rot, &pair_norot, &bond_rot, &bond_norot,
+                             &integrate_rot, &integrate_norot};
   return set;
 }
 

@@ -7,6 +7,7 @@
 #include <xsimd/xsimd.hpp>
 
 #include "kernels/bond_loop.hpp"
+#include "kernels/integrate_loop.hpp"
 #include "kernels/pair_loop.hpp"
 
 #define ASPERITY_CAT2(a, b) a##b
@@ -37,6 +38,16 @@ struct SimdLanes {
   static Real load(const double* p) { return Real::load_aligned(p); }
   static void store(double* p, const Real& v) { v.store_aligned(p); }
   static double sum(const Real& v) { return xsimd::hadd(v); }
+  static Real iota(double start) {
+    alignas(64) double l[size];
+    for (std::size_t j = 0; j < size; ++j) l[j] = start + double(j);
+    return Real::load_aligned(l);
+  }
+  static double lane(const Real& v, std::size_t j) {
+    alignas(64) double l[size];
+    v.store_aligned(l);
+    return l[j];
+  }
 };
 
 double pair_rot(const PairKernelArgs& k, std::size_t b, std::size_t e) {
@@ -52,6 +63,13 @@ double bond_norot(const BondKernelArgs& k, std::size_t b, std::size_t e) {
   return bond_loop<SimdLanes, false>(k, b, e);
 }
 
+void integrate_rot(const IntegrateArgs& k, std::size_t b, std::size_t e, IntegrateSums& out) {
+  integrate_loop<SimdLanes, true>(k, b, e, out);
+}
+void integrate_norot(const IntegrateArgs& k, std::size_t b, std::size_t e, IntegrateSums& out) {
+  integrate_loop<SimdLanes, false>(k, b, e, out);
+}
+
 }  // namespace
 
 #define ASPERITY_STR2(a) #a
@@ -59,7 +77,8 @@ double bond_norot(const BondKernelArgs& k, std::size_t b, std::size_t e) {
 
 const KernelSet& ASPERITY_CAT(kernels_, ASPERITY_SIMD_ARCH)() {
   static const KernelSet set{ASPERITY_STR(ASPERITY_SIMD_ARCH), SimdLanes::size, &pair_rot,
-                             &pair_norot, &bond_rot, &bond_norot};
+                             &pair_norot, &bond_rot, &bond_norot,
+                             &integrate_rot, &integrate_norot};
   return set;
 }
 

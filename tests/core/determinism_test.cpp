@@ -1,7 +1,10 @@
 // Results do not depend on the thread count, and the SIMD kernels equal the scalar reference.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
+#include <limits>
+#include <utility>
 #include <random>
 
 #include "core/aligned.hpp"
@@ -105,6 +108,94 @@ TEST(Determinism, SimdKernelsEqualTheScalarReferenceBitwise) {
       EXPECT_GT(touching, pairs / 4);
       EXPECT_LT(touching, 3 * pairs / 4);
     }
+  }
+}
+
+namespace {
+// Random particles for the integrate kernel: free, in a group (not moved), rotation locked, one
+// non-finite velocity; damping on, gravity and applied forces; n not a multiple of the lanes.
+struct RandomParticles {
+  static constexpr std::size_t n = 1021, padded = 1024;
+  using Col = std::vector<double, AlignedAllocator<double>>;
+  Col x, y, z, vx, vy, vz, wx, wy, wz, fx, fy, fz, tx, ty, tz, x0, y0, z0, m, im, I, iI, r, ax, ay, az,
+      free, spin;
+  explicit RandomParticles(unsigned seed, bool with_nan) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (auto* c : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &fx, &fy, &fz, &tx, &ty, &tz, &x0, &y0,
+                    &z0, &m, &im, &I, &iI, &r, &ax, &ay, &az, &free, &spin})
+      c->assign(padded, 0.0);
+    for (std::size_t i = 0; i < n; ++i) {
+      r[i] = 5e-4 * (1 + 0.3 * u(rng));
+      m[i] = 2500 * 4.18879 * r[i] * r[i] * r[i];
+      im[i] = 1 / m[i];
+      I[i] = 0.4 * m[i] * r[i] * r[i];
+      iI[i] = 1 / I[i];
+      x[i] = u(rng); y[i] = u(rng); z[i] = u(rng);
+      x0[i] = x[i] + 1e-5 * u(rng); y0[i] = y[i]; z0[i] = z[i];
+      vx[i] = 1e-3 * u(rng); vy[i] = (i % 7 == 0) ? 0.0 : 1e-3 * u(rng); vz[i] = 1e-3 * u(rng);
+      wx[i] = u(rng); wy[i] = u(rng); wz[i] = u(rng);
+      fx[i] = 1e-5 * u(rng); fy[i] = 1e-5 * u(rng); fz[i] = 1e-5 * u(rng);
+      tx[i] = 1e-9 * u(rng); ty[i] = 1e-9 * u(rng); tz[i] = 1e-9 * u(rng);
+      ax[i] = 1e-6 * u(rng); ay[i] = 0; az[i] = 1e-6 * u(rng);
+      free[i] = (i % 11 == 3) ? 0.0 : 1.0;
+      spin[i] = (free[i] != 0 && i % 5 != 1) ? 1.0 : 0.0;
+    }
+    if (with_nan) vz[517] = std::numeric_limits<double>::quiet_NaN();
+  }
+  kernels::IntegrateArgs args() {
+    return {x.data(), y.data(), z.data(), vx.data(), vy.data(), vz.data(), wx.data(), wy.data(),
+            wz.data(), fx.data(), fy.data(), fz.data(), tx.data(), ty.data(), tz.data(), x0.data(),
+            y0.data(), z0.data(), m.data(), im.data(), I.data(), iI.data(), r.data(), ax.data(),
+            ay.data(), az.data(), free.data(), spin.data(), 1e-4, 0.7, 0.0, 0.0, -9.81};
+  }
+};
+}  // namespace
+
+TEST(Determinism, SimdIntegrateEqualsTheScalarReferenceBitwise) {
+  const auto& sk = kernels::scalar_kernels();
+  for (const auto& arch : available_simd_architectures()) {
+    const auto& simd = kernels::select_kernels(arch);
+    for (bool rotation : {true, false})
+      for (bool with_nan : {false, true}) {
+        RandomParticles ref(5, with_nan), got(5, with_nan);
+        kernels::IntegrateSums sr, sg;
+        (rotation ? sk.integrate : sk.integrate_norot)(ref.args(), 0, RandomParticles::padded, sr);
+        (rotation ? simd.integrate : simd.integrate_norot)(got.args(), 0, RandomParticles::padded, sg);
+        auto same = [](const auto& u, const auto& v) {
+          return std::memcmp(u.data(), v.data(), u.size() * sizeof(double)) == 0;
+        };
+        for (auto c : {&RandomParticles::x, &RandomParticles::y, &RandomParticles::z,
+                       &RandomParticles::vx, &RandomParticles::vy, &RandomParticles::vz,
+                       &RandomParticles::wx, &RandomParticles::wy, &RandomParticles::wz})
+          EXPECT_TRUE(same(ref.*c, got.*c)) << arch;
+        // Particles that are not free keep their state; locked ones keep their spin.
+        RandomParticles before(5, with_nan);
+        EXPECT_EQ(got.x[3], before.x[3]);
+        EXPECT_EQ(got.vx[14], before.vx[14]);
+        EXPECT_EQ(got.wx[1], before.wx[1]);
+        EXPECT_EQ(got.x[RandomParticles::n], 0.0) << "padding untouched";
+        if (rotation) EXPECT_NE(got.wx[0], before.wx[0]);
+        else EXPECT_EQ(got.wx[0], before.wx[0]);
+        // Sums are per lane, then over lanes: equal to rounding. The extremes are exact.
+        for (auto [a, b] : {std::pair{sr.damping, sg.damping}, {sr.gravity, sg.gravity},
+                            {sr.applied, sg.applied}, {sr.kinetic, sg.kinetic}}) {
+          if (with_nan) continue;
+          EXPECT_NEAR(b, a, 1e-12 * std::abs(a)) << arch;
+          EXPECT_NE(a, 0.0);
+        }
+        if (with_nan) {
+          EXPECT_EQ(sr.worst, 517);
+          EXPECT_TRUE(std::isnan(sr.worst_step));
+          EXPECT_TRUE(std::isnan(sr.max_disp2));
+        } else {
+          EXPECT_GT(sr.damping, 0.0) << "local damping dissipates";
+          EXPECT_EQ(sg.max_disp2, sr.max_disp2) << arch;
+          EXPECT_EQ(sg.worst_step, sr.worst_step) << arch;
+        }
+        EXPECT_EQ(sg.worst, sr.worst) << arch;
+        EXPECT_TRUE(std::isnan(sg.max_disp2) == with_nan) << arch;
+      }
   }
 }
 
