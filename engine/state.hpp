@@ -21,6 +21,7 @@ struct Group {
   Vec3 inert_shift{0, 0, 0};          // group displacement not yet applied to the inert members
   double inert_mass = 0;
   Vec3 servo_origin{0, 0, 0};         // centre when the motion was set (CNS reference)
+  Vec3 servo_integral{0, 0, 0};       // int (F - F_target) dt per servo axis since the motion was set
   double contact_stiffness = 0;       // summed kn of the members' contacts (servo gain)
   GroupMotion motion;
   double mass = 0;

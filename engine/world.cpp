@@ -462,9 +462,14 @@ void World::set_group_motion(int group, const GroupMotion& motion) {
     require(std::isfinite(sv.gain) && sv.gain >= 0, where + "gain must be >= 0 (0: automatic)");
     require(sv.relaxation > 0 && sv.relaxation <= 1, where + "relaxation must be in (0, 1]");
     require(sv.max_velocity > 0 && std::isfinite(sv.max_velocity), where + "max_velocity must be > 0 (m/s)");
+    require(std::isfinite(sv.integral_time) && sv.integral_time >= 0,
+            where + "integral_time must be >= 0 (s; 0: proportional only)");
   }
+  require(std::isfinite(motion.damping) && motion.damping < 1,
+          "group damping must be below 1 (a negative value: the world's local damping)");
   g.motion = motion;
   g.servo_origin = g.centre;
+  g.servo_integral = {0, 0, 0};
 }
 const GroupMotion& World::group_motion(int group) const { return state_->groups[check_group(*state_, group)].motion; }
 void World::set_group_applied_force(int group, Vec3 f) {

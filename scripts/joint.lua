@@ -39,7 +39,11 @@ local P = require("params").defaults{
   direction = "x",         -- x | y: the upper half moves along -x or -y
   shear = 5,               -- shear displacement, mm
   velocity = 3e-5,         -- shear velocity, m/s
-  normal_control = "load", -- load: constant applied force on a free platen (dead load); servo
+  normal_control = "servo", -- servo (model.md 7, with integral action) or load: a constant force on a free platen
+  platen_damping = 0,      -- local damping of the dead-load platen (< 0: the world's)
+  servo_relaxation = 0.4,  -- servo gain: fraction of the force error the platen contacts correct per step
+  servo_integral_steps = 2, -- integral time of the servo, in time steps (0: proportional only, model.md 7)
+  servo_max_velocity = 100, -- the servo's speed limit, in shear velocities
   closure_velocity = 6e-5, -- m/s [thesis 4.2.2]
   closure_every = 50,      -- steps between closure records (the source: 500; finer for the stiffness fit)
   approach_gap = 0.2e-3,    -- m, smallest gap left between the halves after lowering the upper one
@@ -380,16 +384,19 @@ local axis = P.direction == "x" and 1 or 2
 local shear_velocity = {0, 0, 0}
 shear_velocity[axis] = -P.velocity
 -- Constant normal load. "load": the platen is free along z under a constant applied force, a dead
--- weight: it follows any dilatancy at once and the load it transmits differs from the target only
--- by its inertia. "servo" (model.md 7): the platen's z velocity follows the force error; its
--- stable gain is set by the stiff platen-specimen bonds, so it lags when the joint dilates fast.
+-- weight, undamped (local damping would bias the load it transmits by alpha times the mean force
+-- noise): it follows any dilatancy at once and the load it transmits differs from the target only
+-- by its inertia. "servo" (model.md 7): the platen's z velocity follows the force error, with
+-- integral action (servo_integral_time) so that a steady dilatancy rate leaves no lag.
 local modes = {"fixed", "fixed", P.normal_control == "servo" and "servo" or "free"}
 modes[axis] = "velocity"
 if P.normal_control == "servo" then
   world:set_group_motion(top, {translation = modes, velocity = shear_velocity,
-                               servo = {target_force = target_stress * area, max_velocity = 10 * P.velocity}})
+                               servo = {target_force = target_stress * area, max_velocity = P.servo_max_velocity * P.velocity,
+                                        relaxation = P.servo_relaxation,
+                                        integral_time = P.servo_integral_steps * world:dt()}})
 elseif P.normal_control == "load" then
-  world:set_group_motion(top, {translation = modes, velocity = shear_velocity})
+  world:set_group_motion(top, {translation = modes, velocity = shear_velocity, damping = P.platen_damping})
   applied_z = -target_stress * area
   world:set_group_force(top, {0, 0, applied_z})
 else
@@ -501,13 +508,18 @@ for k = cat, rows do
 end
 local q = fit(lx, ly)
 local sn_mean = shear:column("normal_stress_mean_mpa")
-local sn_dev, sn_dev_mean = 0, 0
+local sn_dev, sn_dev_mean, devs = 0, 0, {}
 for k = 1, rows do
   if u[k] > 0.05 then
     sn_dev = math.max(sn_dev, math.abs(sn[k] / P.stress - 1))
-    sn_dev_mean = math.max(sn_dev_mean, math.abs(sn_mean[k] / P.stress - 1))
+    devs[#devs + 1] = math.abs(sn_mean[k] / P.stress - 1)
+    sn_dev_mean = math.max(sn_dev_mean, devs[#devs])
   end
 end
+table.sort(devs)
+local within = 0
+for _, d in ipairs(devs) do if d <= 0.01 then within = within + 1 end end
+local sn_dev_p95 = #devs > 0 and devs[math.max(1, math.ceil(0.95 * #devs))] or 0/0
 local e = world:energies()
 local input = e.boundary_work - e0.boundary_work
 local function share(v) return input ~= 0 and v / input or 0/0 end
@@ -531,6 +543,8 @@ local summary = {
   normal_stiffness_mpa_per_mm = normal_stiffness,
   normal_stress_max_deviation = sn_dev_mean,          -- of the interval means (after 0.05 mm)
   normal_stress_max_deviation_instant = sn_dev,       -- of the values at the recorded steps
+  normal_stress_deviation_p95 = sn_dev_p95,           -- 95th percentile of the interval-mean deviation
+  normal_stress_within_1pct = #devs > 0 and within / #devs or 0/0,  -- fraction of records within 1 %
   broken_bonds = world:break_count(),
   contact_decay_exponent = q,
   max_contacts = cmax,

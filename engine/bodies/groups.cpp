@@ -30,11 +30,12 @@ Vec3 rotate(const Vec3& r, const Vec3& theta) {
 
 void advance_groups(State& s) {
   ParticleStore& p = s.p;
-  const double dt = s.dt, alpha = s.settings.local_damping;
+  const double dt = s.dt;
   const Vec3 g = s.settings.gravity;
   double kinetic = 0;
   for (Group& grp : s.groups) {
     if (grp.members.empty()) continue;
+    const double alpha = grp.motion.damping >= 0 ? grp.motion.damping : s.settings.local_damping;
     Vec3 F = grp.applied, T{0, 0, 0};
     for (std::int32_t i : grp.members) {
       const Vec3 f{p.fx[i], p.fy[i], p.fz[i]};
@@ -64,15 +65,29 @@ void advance_groups(State& s) {
         case Dof::velocity:
         case Dof::servo: {
           if (grp.motion.translation[k] == Dof::servo) {
-            // model.md 7: v = clamp(G (F - F_target), -vmax, vmax), target moving with CNS.
+            // model.md 7: v = clamp(G (F - F_target), -vmax, vmax), target moving with CNS;
+            // with integral_time Ti > 0, v = G (e + I / Ti), I = int e dt, integrated only while
+            // the velocity is not clamped (no wind-up while the platen runs at vmax).
             const Servo& sv = grp.motion.servo[k];
             const double shift = grp.centre[k] - grp.servo_origin[k];
             const double target = sv.target_force + sv.stiffness * shift;
             const double error = Fk[k] - target;
+            double gain = 0;
+            if (sv.gain > 0) gain = sv.gain;
+            else if (grp.contact_stiffness > 0) gain = sv.relaxation / (grp.contact_stiffness * dt);
             double v;
-            if (sv.gain > 0) v = sv.gain * error;
-            else if (grp.contact_stiffness > 0) v = sv.relaxation / (grp.contact_stiffness * dt) * error;
-            else v = error > 0 ? sv.max_velocity : (error < 0 ? -sv.max_velocity : 0.0);
+            if (gain > 0) {
+              double& stored = k == 0 ? grp.servo_integral.x : (k == 1 ? grp.servo_integral.y : grp.servo_integral.z);
+              double integral = stored;
+              if (sv.integral_time > 0) {
+                const double trial = integral + error * dt;
+                if (std::fabs(gain * (error + trial / sv.integral_time)) <= sv.max_velocity) integral = trial;
+                stored = integral;
+              }
+              v = gain * (error + (sv.integral_time > 0 ? integral / sv.integral_time : 0.0));
+            } else {
+              v = error > 0 ? sv.max_velocity : (error < 0 ? -sv.max_velocity : 0.0);
+            }
             Vn[k] = std::clamp(v, -sv.max_velocity, sv.max_velocity);
           } else {
             Vn[k] = grp.motion.translation[k] == Dof::fixed ? 0.0 : Vp[k];

@@ -21,7 +21,7 @@ namespace asperity {
 namespace {
 
 using detail::State;
-constexpr int kCheckpointVersion = 1;
+constexpr int kCheckpointVersion = 2;  // 2: servo integral and integral time, group damping
 
 template <class T>
 hid_t native_type() {
@@ -36,6 +36,7 @@ hid_t native_type() {
 struct Writer {
   hid_t file;
   std::string path;
+  int version = kCheckpointVersion;
   template <class T>
   void raw(const std::string& name, const T* data, std::size_t n) {
     const hsize_t dims[1] = {n};
@@ -72,6 +73,7 @@ struct Writer {
 struct Reader {
   hid_t file;
   std::string path;
+  int version = kCheckpointVersion;  // of the file: fields added later keep their defaults
   template <class T>
   std::vector<T> raw(const std::string& name) {
     if (H5Lexists(file, name.c_str(), H5P_DEFAULT) <= 0)
@@ -314,6 +316,7 @@ void visit(Io& io, State& s) {
     io.vec(at + "/inert_shift", grp.inert_shift);
     io.scalar(at + "/inert_mass", grp.inert_mass);
     io.vec(at + "/servo_origin", grp.servo_origin);
+    if (io.version >= 2) io.vec(at + "/servo_integral", grp.servo_integral);
     io.scalar(at + "/contact_stiffness", grp.contact_stiffness);
     io.scalar(at + "/mass", grp.mass);
     io.vec(at + "/centre", grp.centre);
@@ -337,7 +340,9 @@ void visit(Io& io, State& s) {
       io.scalar(sv + "/gain", m.servo[k].gain);
       io.scalar(sv + "/relaxation", m.servo[k].relaxation);
       io.scalar(sv + "/max_velocity", m.servo[k].max_velocity);
+      if (io.version >= 2) io.scalar(sv + "/integral_time", m.servo[k].integral_time);
     }
+    if (io.version >= 2) io.scalar(at + "/damping", m.damping);
   }
 }
 
@@ -365,9 +370,10 @@ World World::load(const std::string& path, int threads, const std::string& simd)
   Reader r{h, path};
   int version = 0;
   r.scalar("asperity_checkpoint_version", version);
-  if (version != kCheckpointVersion)
+  if (version < 1 || version > kCheckpointVersion)
     throw Error("checkpoint '" + path + "' has version " + std::to_string(version) +
-                ", this build reads version " + std::to_string(kCheckpointVersion));
+                ", this build reads versions 1 to " + std::to_string(kCheckpointVersion));
+  r.version = version;
   World world;
   State& s = world.state();
   visit(r, s);

@@ -397,6 +397,7 @@ Servo servo_fields(lua_State* L, int index, const std::string& context, Servo s)
   s.gain = o.number("gain", s.gain);
   s.relaxation = o.number("relaxation", s.relaxation);
   s.max_velocity = o.number("max_velocity", s.max_velocity);
+  s.integral_time = o.number("integral_time", s.integral_time);
   o.finish();
   return s;
 }
@@ -409,10 +410,11 @@ void push_servo(lua_State* L, const Servo& s) {
   num("gain", s.gain);
   num("relaxation", s.relaxation);
   num("max_velocity", s.max_velocity);
+  num("integral_time", s.integral_time);
 }
 
 // motion = {translation = "free"|"fixed"|"velocity"|"servo" or one per axis, velocity = vec,
-//           servo = {target_force=, stiffness=, gain=, relaxation=, max_velocity=} (for every
+//           servo = {target_force=, stiffness=, gain=, relaxation=, max_velocity=, integral_time=} (for every
 //           servo axis) or three such tables, rotation = "free"|"fixed"|"velocity",
 //           angular_velocity = vec}
 GroupMotion motion_arg(lua_State* L, int index, const std::string& context, int arg,
@@ -462,6 +464,7 @@ GroupMotion motion_arg(lua_State* L, int index, const std::string& context, int 
     }
   }
   lua_pop(L, 1);
+  m.damping = o.number("damping", m.damping);
   std::string rotation = o.string("rotation", "");
   if (!rotation.empty()) m.rotation = dof_from_name(rotation, context + " option 'rotation'");
   if (auto w = o.vec("angular_velocity")) {
@@ -492,6 +495,8 @@ void push_motion(lua_State* L, const GroupMotion& m) {
   lua_setfield(L, -2, "rotation");
   push_vec(L, m.angular_velocity);
   lua_setfield(L, -2, "angular_velocity");
+  lua_pushnumber(L, m.damping);
+  lua_setfield(L, -2, "damping");
 }
 
 // Particles named by a list of ids (table or Array) or by a predicate function(id, pos, r)
@@ -1220,7 +1225,8 @@ void open_world(lua_State* L) {
        "A rigid group of particles: a list of ids, or function(id, pos, r) returning true for\n"
        "members. motion = {translation = \"free\"|\"fixed\"|\"velocity\"|\"servo\" (or one per\n"
        "axis), velocity = v, servo = {target_force=, stiffness=, gain=, relaxation=,\n"
-       "max_velocity=}, rotation = \"fixed\"|\"free\"|\"velocity\", angular_velocity = w}.\n"
+       "max_velocity=, integral_time=}, rotation = \"fixed\"|\"free\"|\"velocity\", angular_velocity = w,\n"
+       "damping = local damping of the free axes (default: the world's; 0 for a dead-load platen)}.\n"
        "Default: free translation, no rotation. Giving velocity alone prescribes it."},
       {"set_group_motion", world_set_group_motion, "world:set_group_motion(group, motion)",
        "Changes how the group moves (fields not given are kept); see add_group."},

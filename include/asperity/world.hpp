@@ -77,6 +77,8 @@ struct Servo {
                               // stiffness of the group's contacts
   double relaxation = 0.2;    // fraction of the force error corrected per step (automatic gain)
   double max_velocity = 1e-3; // m/s
+  double integral_time = 0;   // s; > 0 adds integral action, v = G (e + (1/Ti) int e dt): a P servo
+                              // lags by v/G whenever the specimen dilates at a steady rate
 };
 
 struct GroupMotion {
@@ -85,6 +87,10 @@ struct GroupMotion {
   std::array<Servo, 3> servo{};    // used on the axes whose mode is Dof::servo
   Dof rotation = Dof::fixed;       // all three rotational axes together (the thesis locks them)
   Vec3 angular_velocity{0, 0, 0};  // used when rotation == Dof::velocity
+  // Local damping of the free axes; < 0: the world's. A dead-load platen wants 0: damping by
+  // |unbalanced force| pushes back harder while it rises than while it sinks, so the load it
+  // transmits is biased by alpha times the mean magnitude of the force noise.
+  double damping = -1;
 };
 
 struct ContactInfo {  // one ball-ball contact (touching pair), for inspection and output

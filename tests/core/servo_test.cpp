@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <utility>
 #include <numbers>
 
 #include "asperity/world.hpp"
@@ -82,12 +84,61 @@ TEST(Servo, ConstantNormalStiffnessTargetFollowsTheDisplacement) {
   EXPECT_NEAR(c.w.group_force(c.platen).z, F0 + K * dz, 0.002 * F0);
 }
 
+// A platen pressed on a floor that sinks at a steady rate u (the way a dilating joint asks the
+// platen to rise): the proportional servo must move at u, so it lags by e = u / G with
+// G = relaxation / (K dt) [model.md 7]; integral action removes the lag.
+TEST(Servo, IntegralActionRemovesTheLagOfASteadyRamp) {
+  const double target = 2e-5, u = 3e-5;
+  auto run = [&](double integral_steps) {
+    WorldSettings ws;
+    ws.rotation = false;
+    ws.dt = 1e-3;
+    World w(ws);
+    const int floor = w.add_plane({0, 0, 0}, {0, 0, 1});
+    std::vector<std::int64_t> members;
+    for (int i = 0; i < 5; ++i)
+      for (int j = 0; j < 5; ++j) members.push_back(w.add_particle({i * 2.2 * kR, j * 2.2 * kR, 0.99 * kR}, kR));
+    GroupMotion m = servo_z(target);
+    m.servo[2].integral_time = integral_steps * ws.dt;
+    const int platen = w.add_group(members, m);
+    w.cycle(20000);  // settle on the target
+    w.set_wall_velocity(floor, {0, 0, -u});
+    w.cycle(20000);
+    double lo = 1e300, hi = -1e300;
+    for (int k = 0; k < 100; ++k) {
+      w.cycle(10);
+      const double e = w.group_force(platen).z - target;
+      lo = std::min(lo, e);
+      hi = std::max(hi, e);
+    }
+    EXPECT_NEAR(w.group_velocity(platen).z, -u, 1e-3 * u) << "the platen follows the floor";
+    return std::make_pair(lo, hi);
+  };
+  const double K = 25 * 0.1, G = 0.2 / (K * 1e-3);  // 25 wall contacts of kn = 0.1 N/m
+  const auto [plo, phi] = run(0);
+  EXPECT_NEAR(plo, -u / G, 1e-6 * u / G) << "proportional servo: steady lag u / G";
+  EXPECT_NEAR(phi, -u / G, 1e-6 * u / G);
+  EXPECT_GT(u / G, 0.01 * target) << "a lag of more than 1 %: the case integral action is for";
+  double pi_dev = 0;
+  for (double steps : {2.0, 20.0}) {
+    const auto [lo, hi] = run(steps);
+    const double dev = std::max(std::fabs(lo), std::fabs(hi));
+    EXPECT_LT(dev, 1e-6 * target) << "integral time " << steps << " steps";
+    if (steps == 2.0) pi_dev = dev / target;
+  }
+  std::printf("[figure] servo on a floor sinking at u: lag P-only %.4g of the target (u/G = %.4g); "
+              "with integral time 2 steps: %.2g\n", -plo / target, u / G / target, pi_dev);
+}
+
 TEST(Servo, BadServoParametersAreRefused) {
   GroupMotion m = servo_z(1e-5);
   m.servo[2].max_velocity = 0;
   EXPECT_THROW(column(m), Error);
   m = servo_z(1e-5);
   m.servo[2].relaxation = 2;
+  EXPECT_THROW(column(m), Error);
+  m = servo_z(1e-5);
+  m.servo[2].integral_time = -1;
   EXPECT_THROW(column(m), Error);
 }
 

@@ -47,6 +47,15 @@ local motion = w:group_motion(g2)
 assert(motion.translation[1] == "velocity" and motion.velocity.x == 0.01)
 w:set_group_motion(g2, {translation = {"velocity", "fixed", "free"}})
 assert(w:group_motion(g2).translation[3] == "free")
+assert(w:group_motion(g2).damping < 0, "default: the world's local damping")
+w:set_group_motion(g2, {translation = {"velocity", "fixed", "servo"}, damping = 0,
+                        servo = {target_force = 1e-6, integral_time = 0.01}})
+assert(w:group_motion(g2).damping == 0 and w:group_motion(g2).servo[3].integral_time == 0.01)
+local ok, err = pcall(w.set_group_motion, w, g2, {servo = {integral_time = -1}})
+assert(not ok and tostring(err):find("integral_time"), tostring(err))
+ok, err = pcall(w.set_group_motion, w, g2, {damping = 1.5})
+assert(not ok and tostring(err):find("damping"), tostring(err))
+w:set_group_motion(g2, {translation = {"velocity", "fixed", "free"}, damping = -1})
 
 -- labels
 w:set_tag(function(id) return id >= 4 end, 7)

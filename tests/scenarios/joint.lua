@@ -20,6 +20,14 @@ assert(s5.peak_shear_stress_mpa > s4.peak_shear_stress_mpa,
 assert(s5.max_dilatancy_mm > s4.max_dilatancy_mm, "S5 dilates more than S4")
 
 local el = joint{surface = "S1", model = "elastic", out = out .. "/S1_elastic"}
+-- Constant normal load (model.md 7): the servo holds the normal stress (interval means) within 1 %
+-- over the shear; only the snap-through of an interlocked asperity may take it further, briefly.
+for name, s in pairs{S4_rigid = s4, S5_rigid = s5, S1_elastic = el} do
+  assert(s.normal_stress_deviation_p95 <= 0.01,
+         ("%s: 95th percentile of the normal-stress deviation %.4f > 1 %%"):format(name, s.normal_stress_deviation_p95))
+  assert(s.normal_stress_within_1pct >= 0.95,
+         ("%s: only %.3f of the records within 1 %% of the normal stress"):format(name, s.normal_stress_within_1pct))
+end
 assert(math.abs(el.energy_balance_error) < 0.01,
        ("energy balance error %.3g of the input work"):format(el.energy_balance_error))
 assert(el.input_work_j > 0 and el.energy_shares.friction > 0.5, "friction takes most of the input work")
@@ -41,4 +49,8 @@ local d = asperity.read_h5(out .. "/S1_elastic/shear.h5", "/displacement")
 assert(d[#d] >= 1.0 - 1e-9, "sheared to 1 mm")
 print(("S4 peak %.3g MPa, S5 peak %.3g MPa; elastic S1: balance error %.2g, friction share %.2f"):format(
   s4.peak_shear_stress_mpa, s5.peak_shear_stress_mpa, el.energy_balance_error, el.energy_shares.friction))
+print(("[figure] normal stress held: p95 deviation S4 %.4f S5 %.4f S1 elastic %.4f; within 1 %%: %.3f %.3f %.3f; max %.3f %.3f %.3f"):format(
+  s4.normal_stress_deviation_p95, s5.normal_stress_deviation_p95, el.normal_stress_deviation_p95,
+  s4.normal_stress_within_1pct, s5.normal_stress_within_1pct, el.normal_stress_within_1pct,
+  s4.normal_stress_max_deviation, s5.normal_stress_max_deviation, el.normal_stress_max_deviation))
 print("PASS")
