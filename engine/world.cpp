@@ -720,6 +720,18 @@ void World::set_dt(double dt) {
   state_->last_estimate_step = 0;
   state_->need_rebuild = true;  // forces a fresh estimate (and its check) before the next step
 }
+void World::set_dt_safety(double f) {
+  require(f > 0 && f <= 2, "dt_safety must be in (0, 2], got " + num(f));
+  state_->settings.dt_safety = f;
+  state_->last_estimate_step = 0;
+  state_->need_rebuild = true;  // a fresh estimate before the next step
+}
+void World::set_skin(double skin) {
+  require(skin > 0 && std::isfinite(skin), "skin must be > 0 (m), got " + num(skin));
+  state_->settings.skin = skin;
+  state_->skin = skin;
+  state_->need_rebuild = true;
+}
 double World::critical_dt() {
   State& s = *state_;
   if (s.need_rebuild && s.p.n > 0) detail::build_neighbors(s);

@@ -53,6 +53,8 @@ local P = require("params").defaults{
   seed = 1,
   pack_steps = 300000,     -- most steps spent cycling the packing towards the ratio 1e-4
   record = 0.01,           -- mm of shear between records
+  dt_safety = 0,           -- time step / critical estimate for closure and shear (0: the engine's 0.8)
+  skin = 0,                -- Verlet skin, m (0: as packed, 0.4 mean radius)
   snapshots = "0,1,2.5,5", -- mm of shear
   band = 0,                -- surface vs porosity band, m (0: mean radius)
   out = "out/joint",
@@ -202,6 +204,9 @@ if f then
 else
   world = build_specimen()
 end
+-- Numerical settings of the test (perf/runtime_vs_error.lua chose them; 0 keeps the engine's).
+if P.dt_safety > 0 then world:set_dt_safety(P.dt_safety) end
+if P.skin > 0 then world:set_skin(P.skin) end
 local N = world:particle_count()
 local lower, upper = {}, {}
 for id = 1, N do

@@ -1035,6 +1035,18 @@ int world_set_dt(lua_State* L) {
     return 0;
   });
 }
+int world_set_dt_safety(lua_State* L) {
+  return guarded(L, [&] {
+    world_arg(L).set_dt_safety(check_number(L, 2));
+    return 0;
+  });
+}
+int world_set_skin(lua_State* L) {
+  return guarded(L, [&] {
+    world_arg(L).set_skin(check_number(L, 2));
+    return 0;
+  });
+}
 int world_critical_dt(lua_State* L) {
   return guarded(L, [&] { lua_pushnumber(L, world_arg(L).critical_dt()); return 1; });
 }
@@ -1295,6 +1307,9 @@ void open_world(lua_State* L) {
        "when stop_when, not steps, ends the run. reason: \"steps\", \"equilibrium\" or \"stop_when\"."},
       {"dt", world_dt, "world:dt() -> s", "The time step in use."},
       {"set_dt", world_set_dt, "world:set_dt(dt)", "Fixes the time step (0: automatic again)."},
+      {"set_dt_safety", world_set_dt_safety, "world:set_dt_safety(f)",
+       "Automatic time step = f x the critical estimate (default 0.8; 0 < f <= 2)."},
+      {"set_skin", world_set_skin, "world:set_skin(m)", "Verlet skin in m (the list is rebuilt)."},
       {"critical_dt", world_critical_dt, "world:critical_dt() -> s",
        "Critical time step estimate now, without the safety factor."},
       {"step", world_step, "world:step() -> n", "Steps done so far."},
