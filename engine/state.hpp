@@ -97,6 +97,7 @@ struct State {
 
 // Stages of one step (engine/step.cpp runs them in this order).
 void build_neighbors(State& s);         // neighbor/build.cpp
+void ensure_skin(State& s);             // neighbor/build.cpp: derive the automatic skin if unset
 void compute_pair_forces(State& s);     // kernels/pairs.cpp
 void compute_wall_forces(State& s);     // kernels/walls.cpp
 void compute_bond_forces(State& s);     // kernels/bonds.cpp

@@ -590,7 +590,10 @@ std::size_t World::install_bonds(const BondMaterial& material, double tolerance,
   std::vector<std::uint8_t> chosen(p.n, ids.empty() ? 1 : 0);
   for (auto id : ids) chosen[index_of(s, id)] = 1;
   // Candidates come from the neighbour list; make sure it is current and reaches the tolerance.
-  if (s.skin <= 0 || s.skin < tolerance) s.skin = std::max(s.skin, 2 * tolerance);
+  // (The skin is derived first: a world never built has none yet, and 2 x tolerance alone, about
+  // 1e-3 R, would leave it rebuilding the list at every step.)
+  detail::ensure_skin(s);
+  if (s.skin < 2 * tolerance) s.skin = 2 * tolerance;
   detail::build_neighbors(s);
   const auto& q = s.pairs;
   std::vector<std::size_t> picked;

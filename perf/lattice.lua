@@ -5,10 +5,16 @@
 --   fixed, skin 0.1 d, a tiny random initial velocity; `warmup` steps, then `steps` timed steps.
 --
 --   build/asperity run perf/lattice.lua n=40 steps=1000 threads=2
+--   build/asperity run perf/lattice.lua n=40 bonded=true      # the same block bonded (REV material)
+--
+-- bonded=true: every touching pair gets an unbreakable contact + parallel bond with the REV's bond
+-- stiffnesses (scripts/lib/materials.lua: beam_kn = kn, beam_ks = ks), as the bonded specimens of
+-- the joint scenarios; bonded particles do not rotate (model.md 5), as there.
 --
 -- The last line printed is `particle-steps/s: <number>` (what perf/peers.sh reads); the one before,
 -- particle-steps per CPU-second (see perf/lattice_bench.cpp).
-local P = require("params").defaults{n = 40, steps = 1000, threads = 1, warmup = 200, simd = "auto"}
+local P = require("params").defaults{n = 40, steps = 1000, threads = 1, warmup = 200, simd = "auto",
+                                     bonded = false}
 local n = math.tointeger(P.n) or error("n must be an integer")
 local d, rho = 1e-3, 2500.0
 local a = 0.99 * d
@@ -47,6 +53,11 @@ for _, p in ipairs{
   w:add_plane{point = p[1], normal = p[2], material = material}
 end
 
+if P.bonded then
+  local count = w:install_bonds{breakable = false, beam_kn = kn, beam_ks = kn * 2 / 7}
+  w:set_dt(0)  -- the peers' fixed 5e-4 s is above the bonded block's critical step: automatic
+  print(("bonded: %d bonds, dt %.3g s"):format(count, w:critical_dt() * 0.8))
+end
 if P.warmup > 0 then w:cycle(P.warmup) end
 local st = w:stats()
 print(("lattice n=%d: %d particles, %d pairs, %d contacts, %d wall contacts; simd %s, threads %d")

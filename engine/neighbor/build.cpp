@@ -403,13 +403,17 @@ void build_wall_contacts(State& s) {
 
 }  // namespace
 
+void ensure_skin(State& s) {
+  if (s.skin > 0) return;
+  const ParticleStore& p = s.p;
+  double mean = 0;
+  for (std::size_t i = 0; i < p.n; ++i) mean += p.radius[i];
+  s.skin = s.settings.skin > 0 ? s.settings.skin : 0.4 * (p.n ? mean / double(p.n) : 1e-3);
+}
+
 void build_neighbors(State& s) {
   ParticleStore& p = s.p;
-  if (s.skin <= 0) {
-    double mean = 0;
-    for (std::size_t i = 0; i < p.n; ++i) mean += p.radius[i];
-    s.skin = s.settings.skin > 0 ? s.settings.skin : 0.4 * (p.n ? mean / double(p.n) : 1e-3);
-  }
+  ensure_skin(s);
   CellGrid grid = make_grid(p, s.skin);
   const int every = s.settings.reorder_interval;
   if (p.n > 0 && (s.force_reorder || (every > 0 && s.rebuilds_since_reorder >= std::uint64_t(every)))) {

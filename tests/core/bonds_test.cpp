@@ -231,6 +231,24 @@ TEST(Bonds, InstallationBondsEveryTouchingPairOnce) {
   EXPECT_THROW(w.install_bonds(bad), Error) << "breakable without a strength";
 }
 
+// Bonds installed in a world that never ran keep the world's skin (the search for bonded pairs
+// needs only 2 x tolerance; once, that became the skin, and the list was rebuilt every step).
+TEST(Bonds, InstallingBeforeTheFirstStepKeepsTheSkin) {
+  WorldSettings ws;
+  ws.skin = 0.2 * kR;
+  World w(ws);
+  const int n = 4;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      for (int k = 0; k < n; ++k) w.add_particle({i * 1.99 * kR, j * 1.99 * kR, k * 1.99 * kR}, kR);
+  BondMaterial bm;
+  bm.breakable = false;
+  ASSERT_EQ(w.install_bonds(bm), std::size_t(3 * n * n * (n - 1)));
+  const auto before = w.stats().rebuilds;
+  w.cycle(200);  // the block relaxes its 0.5 % overlaps: moves of order 1e-3 R
+  EXPECT_LE(w.stats().rebuilds - before, 2u);
+}
+
 TEST(Bonds, SimdBondKernelEqualsTheScalarReferenceBitwise) {
   const std::size_t bonds = 2048, n = 2 * bonds;
   std::mt19937_64 rng(5);
