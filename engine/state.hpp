@@ -22,7 +22,7 @@ struct Group {
   double inert_mass = 0;
   Vec3 servo_origin{0, 0, 0};         // centre when the motion was set (CNS reference)
   Vec3 servo_integral{0, 0, 0};       // int (F - F_target) dt per servo axis since the motion was set
-  double contact_stiffness = 0;       // summed kn of the members' contacts (servo gain)
+  double contact_stiffness = 0;       // summed kn of the members' contacts this step (servo gain)
   GroupMotion motion;
   double mass = 0;
   Vec3 centre, velocity, angular_velocity;
@@ -91,6 +91,11 @@ struct State {
   double reference_input = 0;    // boundary + gravity work at that moment
   std::atomic<bool> stop_requested{false};
 
+  // Pairs joining two different bodies (group / group or group / free particle) of the current
+  // pair list, for the servo's per-step stiffness; valid while `rebuilds` equals group_pairs_at.
+  std::vector<std::uint32_t> group_pairs;
+  std::uint64_t group_pairs_at = ~std::uint64_t(0);
+
   std::vector<double> pair_block_slip;
   std::vector<ParticleBlockResult> particle_blocks;
 };
@@ -111,7 +116,7 @@ void advance_groups(State& s);          // bodies/groups.cpp
 double estimate_critical_dt(const State& s);  // step.cpp
 Energies compute_energies(const State& s);    // step.cpp
 void step_once(State& s);               // step.cpp
-void update_servo_stiffness(State& s);  // bodies/groups.cpp
+void update_servo_stiffness(State& s);  // bodies/groups.cpp: every step while a servo acts
 void sync_inert(State& s);              // bodies/groups.cpp: bring inert members up to date
 
 // Geometry helpers shared by the wall kernel and the neighbour search (kernels/walls.cpp).

@@ -28,7 +28,6 @@ namespace {
 }
 
 void check_dt(State& s) {
-  update_servo_stiffness(s);
   s.dt_estimate = estimate_critical_dt(s);
   s.last_estimate_step = s.step;
   if (!s.dt_fixed) {
@@ -218,6 +217,7 @@ void step_once(State& s) {
   compute_bond_forces(s);
   compute_wall_forces(s);
   gather_and_integrate(s);
+  update_servo_stiffness(s);
   advance_groups(s);
   for (auto& w : s.walls.walls) w.displacement += w.velocity * s.dt;
   ++s.step;

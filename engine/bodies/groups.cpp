@@ -74,7 +74,10 @@ void advance_groups(State& s) {
             const double error = Fk[k] - target;
             double gain = 0;
             if (sv.gain > 0) gain = sv.gain;
-            else if (grp.contact_stiffness > 0) gain = sv.relaxation / (grp.contact_stiffness * dt);
+            // A body out of contact counts as meeting one contact (as in the time-step estimate
+            // [3-30]): it approaches at most `relaxation` x (its force error / kn) per step, so the
+            // first contact cannot be overshot by more than the target load needs.
+            else gain = sv.relaxation / (std::max(grp.contact_stiffness, s.settings.contact.kn) * dt);
             double v;
             if (gain > 0) {
               double& stored = k == 0 ? grp.servo_integral.x : (k == 1 ? grp.servo_integral.y : grp.servo_integral.z);
@@ -159,9 +162,23 @@ void advance_groups(State& s) {
   s.kinetic_at_step = kinetic;  // the free particles' share is added in bookkeeping
 }
 
+// The servo gain G = relaxation / (K dt) needs the stiffness K the group meets now: computed every
+// step from this step's overlaps (a stale K, e.g. from before the platen touched, turned the servo
+// into a bang-bang controller that rang between 28 % and 102 % of the target and created energy).
+// Only the pairs joining two bodies can contribute; their indices are collected once per rebuild.
 void update_servo_stiffness(State& s) {
   if (s.groups.empty()) return;
+  bool servo = false;
+  for (const Group& g : s.groups)
+    for (Dof d : g.motion.translation) servo = servo || d == Dof::servo;
+  if (!servo) return;
   const ParticleStore& p = s.p;
+  if (s.group_pairs_at != s.rebuilds) {
+    s.group_pairs.clear();
+    for (std::size_t k = 0; k < s.pairs.n; ++k)
+      if (p.group[s.pairs.a[k]] != p.group[s.pairs.b[k]]) s.group_pairs.push_back(std::uint32_t(k));
+    s.group_pairs_at = s.rebuilds;
+  }
   std::vector<double> K(s.groups.size(), 0.0);
   auto add = [&](std::int64_t a, std::int64_t b, double k) {
     const int ga = p.group[a], gb = p.group[b];
@@ -170,7 +187,7 @@ void update_servo_stiffness(State& s) {
     if (gb >= 0) K[gb] += k;
   };
   const double kn = s.settings.contact.kn;
-  for (std::size_t k = 0; k < s.pairs.n; ++k)
+  for (std::uint32_t k : s.group_pairs)
     if (s.pairs.overlap[k] > 0) add(s.pairs.a[k], s.pairs.b[k], kn);
   for (std::size_t k = 0; k < s.bonds.n; ++k) add(s.bonds.a[k], s.bonds.b[k], kn + s.bonds.material.beam_kn);
   const WallContacts& wc = s.walls.contacts;

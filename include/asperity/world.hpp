@@ -74,7 +74,7 @@ struct Servo {
   double target_force = 0;    // N
   double stiffness = 0;       // N/m; 0: constant normal load (CNL)
   double gain = 0;            // m/s per N; 0: automatic, relaxation / (K dt) with K the summed
-                              // stiffness of the group's contacts
+                              // stiffness of the group's contacts this step (at least one kn)
   double relaxation = 0.2;    // fraction of the force error corrected per step (automatic gain)
   double max_velocity = 1e-3; // m/s
   double integral_time = 0;   // s; > 0 adds integral action, v = G (e + (1/Ti) int e dt): a P servo

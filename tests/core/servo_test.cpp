@@ -130,6 +130,32 @@ TEST(Servo, IntegralActionRemovesTheLagOfASteadyRamp) {
               "with integral time 2 steps: %.2g\n", -plo / target, u / G / target, pi_dev);
 }
 
+// The automatic gain needs the stiffness the platen meets at this step. Estimated only with the
+// time step (every dt_interval steps), it was zero from before the touch: the servo ran at
+// +-max_velocity, ringing between 28 % and 102 % of the load (the rigid joint's hold).
+TEST(Servo, GainFollowsTheContactsOfEveryStep) {
+  const double target = 2e-5;
+  WorldSettings ws;
+  ws.rotation = false;
+  ws.dt = 1e-3;
+  ws.dt_interval = 1000;  // estimates far apart: the servo must not wait for them
+  World w(ws);
+  w.add_plane({0, 0, 0}, {0, 0, 1});
+  std::vector<std::int64_t> members;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j) members.push_back(w.add_particle({i * 2.2 * kR, j * 2.2 * kR, kR + 5e-5}, kR));
+  GroupMotion m = servo_z(target);
+  m.servo[2].max_velocity = 1e-2;  // 1e-5 m per step: more than the 8e-6 m overlap of the target
+  const int platen = w.add_group(members, m);
+  w.cycle(60);  // out of contact for a few steps, then touching
+  double worst = 0;
+  for (int k = 0; k < 40; ++k) {
+    w.cycle(1);
+    worst = std::max(worst, std::fabs(w.group_force(platen).z / target - 1));
+  }
+  EXPECT_LT(worst, 1e-3) << "settled within 60 steps and held";
+}
+
 TEST(Servo, BadServoParametersAreRefused) {
   GroupMotion m = servo_z(1e-5);
   m.servo[2].max_velocity = 0;
