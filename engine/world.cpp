@@ -479,6 +479,7 @@ void World::set_group_applied_force(int group, Vec3 f) {
 Vec3 World::group_force(int group) const { return state_->groups[check_group(*state_, group)].force; }
 Vec3 World::group_torque(int group) const { return state_->groups[check_group(*state_, group)].torque; }
 Vec3 World::group_position(int group) const { return state_->groups[check_group(*state_, group)].centre; }
+Vec3 World::group_impulse(int group) const { return state_->groups[check_group(*state_, group)].impulse; }
 Vec3 World::group_velocity(int group) const { return state_->groups[check_group(*state_, group)].velocity; }
 double World::group_mass(int group) const { return state_->groups[check_group(*state_, group)].mass; }
 std::vector<std::int64_t> World::group_members(int group) const {

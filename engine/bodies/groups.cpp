@@ -45,6 +45,7 @@ void advance_groups(State& s) {
     }
     grp.force = F;
     grp.torque = T;
+    grp.impulse += F * dt;
     const double M = grp.mass;
 
     // Translation, per axis.

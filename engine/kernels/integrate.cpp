@@ -46,6 +46,7 @@ void gather_and_integrate(State& s) {
     kernels::IntegrateArgs a = args;
     a.free = free;
     a.spin = spin;
+    bool any_free = false;
     for (std::size_t i = first; i < end; ++i) {
       if (p.inert[i]) continue;  // no contacts, moved lazily with its group
       double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
@@ -96,8 +97,15 @@ void gather_and_integrate(State& s) {
       }
       p.fx[i] = fx; p.fy[i] = fy; p.fz[i] = fz;
       p.tx[i] = tx; p.ty[i] = ty; p.tz[i] = tz;
+      any_free = any_free || p.group[i] < 0;
       free[i - first] = p.group[i] < 0 ? 1.0 : 0.0;  // else: moved with its group
       spin[i - first] = (p.group[i] < 0 && !p.rotation_locked[i]) ? 1.0 : 0.0;
+    }
+    // A block of rigid-group members only (a rigid joint: all of it) has nothing to integrate;
+    // the kernel would select every lane away and return zero sums.
+    if (!any_free) {
+      s.particle_blocks[blk] = r;
+      continue;
     }
     kernels::IntegrateSums sums;
     integrate(a, first, round_up(end, kMaxLanes), sums);

@@ -1249,6 +1249,9 @@ void open_world(lua_State* L) {
        "A constant external force on the group."},
       {"group_force", get_group_vec<&World::group_force>, "world:group_force(group) -> vec",
        "Contact + applied force on the members, last step (N)."},
+      {"group_impulse", get_group_vec<&World::group_impulse>, "world:group_impulse(group) -> vec",
+       "Sum of group_force x dt since the world was made or loaded (N s): mean force over an "
+       "interval = change of impulse / change of world:time()."},
       {"group_torque", get_group_vec<&World::group_torque>, "world:group_torque(group) -> vec",
        "Torque about the centre of mass (N m)."},
       {"group_position", get_group_vec<&World::group_position>, "world:group_position(group) -> vec", "Centre of mass."},

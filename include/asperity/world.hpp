@@ -223,6 +223,10 @@ class World {
   const GroupMotion& group_motion(int group) const;
   void set_group_applied_force(int group, Vec3 f);
   Vec3 group_force(int group) const;       // sum of contact + applied forces on members, last step
+  // Sum of group_force x dt over the steps since the world was made or loaded (not checkpointed):
+  // the mean force over an interval is the change of the impulse over the change of time(), what
+  // a load cell with a low-pass filter reads, without sampling every step.
+  Vec3 group_impulse(int group) const;
   Vec3 group_torque(int group) const;      // about the centre of mass
   Vec3 group_position(int group) const;    // centre of mass
   Vec3 group_velocity(int group) const;

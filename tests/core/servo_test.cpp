@@ -72,6 +72,18 @@ TEST(Servo, ConstantNormalLoadIsHeldWithinOnePercent) {
     worst = std::max(worst, std::fabs(c.w.group_force(c.platen).z / (2 * target) - 1));
   }
   EXPECT_LT(worst, 0.01);
+  // The impulse is the sum of group_force x dt: its change over a stretch of steps, divided by the
+  // elapsed time, is the mean force the platen carried, what a filtered load cell reads.
+  const Vec3 j0 = c.w.group_impulse(c.platen);
+  const double t0 = c.w.time();
+  double sum = 0;
+  for (int k = 0; k < 500; ++k) {
+    c.w.cycle(1);
+    sum += c.w.group_force(c.platen).z * c.w.dt();
+  }
+  const double mean = (c.w.group_impulse(c.platen).z - j0.z) / (c.w.time() - t0);
+  EXPECT_NEAR(c.w.group_impulse(c.platen).z - j0.z, sum, 1e-12 * std::fabs(sum));
+  EXPECT_NEAR(mean, 2 * target, 0.01 * target);
 }
 
 TEST(Servo, ConstantNormalStiffnessTargetFollowsTheDisplacement) {

@@ -79,6 +79,14 @@ local e = w:energies()
 assert(e.kinetic >= 0 and e.gravity_work ~= nil)
 assert(type(w:energy_balance(e)) == "number")
 assert(w:group_force(g1).z ~= nil and w:group_mass(g1) > 0)
+do  -- the impulse grows by group_force x dt each step
+  local j0, f = w:group_impulse(g1), nil
+  w:cycle(1)
+  f = w:group_force(g1)
+  local j1 = w:group_impulse(g1)
+  assert(math.abs((j1.z - j0.z) - f.z * w:dt()) <= 1e-12 * math.abs(f.z * w:dt()) + 1e-300,
+         "group_impulse: " .. (j1.z - j0.z) .. " vs " .. f.z * w:dt())
+end
 
 -- bulk writes (group members move with their group, so a world without groups)
 local free = asperity.world()
