@@ -467,9 +467,21 @@ void World::set_group_motion(int group, const GroupMotion& motion) {
   }
   require(std::isfinite(motion.damping) && motion.damping < 1,
           "group damping must be below 1 (a negative value: the world's local damping)");
+  // An axis whose servo stays as it was (same target, stiffness and integral time; e.g. only the
+  // shear velocity of another axis changes) keeps its CNS origin and its integral: a reset would
+  // kick the platen at every change of the other axes.
+  for (int k = 0; k < 3; ++k) {
+    const Servo &a = g.motion.servo[k], &b = motion.servo[k];
+    const bool same = g.motion.translation[k] == Dof::servo && motion.translation[k] == Dof::servo &&
+                      a.target_force == b.target_force && a.stiffness == b.stiffness &&
+                      a.integral_time == b.integral_time;
+    if (!same) {
+      auto at = [k](Vec3& v) -> double& { return k == 0 ? v.x : (k == 1 ? v.y : v.z); };
+      at(g.servo_origin) = g.centre[k];
+      at(g.servo_integral) = 0;
+    }
+  }
   g.motion = motion;
-  g.servo_origin = g.centre;
-  g.servo_integral = {0, 0, 0};
 }
 const GroupMotion& World::group_motion(int group) const { return state_->groups[check_group(*state_, group)].motion; }
 void World::set_group_applied_force(int group, Vec3 f) {

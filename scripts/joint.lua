@@ -39,6 +39,8 @@ local P = require("params").defaults{
   direction = "x",         -- x | y: the upper half moves along -x or -y
   shear = 5,               -- shear displacement, mm
   velocity = 3e-5,         -- shear velocity, m/s
+  ramp = 0.05,             -- mm over which the shear velocity rises linearly from 0 (no start-up impact)
+  quasi_static_limit = 0.01, -- warn when the kinetic energy exceeds this x normal load x mean radius
   normal_control = "servo", -- servo (model.md 7, with integral action) or load: a constant force on a free platen
   platen_damping = 0,      -- local damping of the dead-load platen (< 0: the world's)
   servo_relaxation = 0.4,  -- servo gain: fraction of the force error the platen contacts correct per step
@@ -428,7 +430,6 @@ do
             stop_when = function(w)
               return math.abs(normal_stress() / target_stress - 1) < 0.002 and w:unbalanced_force_ratio() < 1e-3
             end}
-  world:set_group_motion(top, {translation = modes, velocity = shear_velocity})
 end
 local shear = asperity.series{"displacement [mm]", "shear_stress [Pa]", "shear_stress_mpa [MPa]",
   "normal_stress_mpa [MPa]", "normal_stress_mean_mpa [MPa]", "dilatancy [mm]", "contacts [1]", "contact_area [%]",
@@ -445,17 +446,22 @@ for v in P.snapshots:gmatch("[^,]+") do snap_at[#snap_at + 1] = tonumber(v) end
 local next_snap = 1
 local contact_points = {}
 local function displacement() return (c0[axis] - world:group_position(top)[axis]) * 1e3 end
--- The normal stress averaged over each recording interval (sampled every step), as a load cell
--- with a low-pass filter reads it: the instantaneous value also carries the platen's inertia at
--- each slip event of the soft model.
-local sn_sum, sn_count = 0, 0
-local function sample_normal()
-  sn_sum, sn_count = sn_sum + normal_stress(), sn_count + 1
-end
+-- The normal stress averaged over each recording interval, as a load cell with a low-pass filter
+-- reads it (the instantaneous value also carries the platen's inertia at each slip event of the
+-- soft model): the change of the platen's impulse over the change of time, so nothing has to be
+-- sampled every step.
+local last_impulse, last_time = world:group_impulse(top)[3], world:time()
+-- Quasi-static check: the specimen's kinetic energy against the work of the normal load over one
+-- mean radius. A rate-independent (quasi-static) test keeps it small; a start-up impact or a
+-- loading rate too high for the material shows up here long before the health checks.
+local dynamic_ratio, dynamic_at = 0, 0
+local energy_scale = target_stress * area * mat.packing.mean_radius
+local shear_impulse, shear_time, shear_disp = {}, {}, {}
 local function record_shear()
   local p, f = world:group_position(top), platen_force()
-  local sn_mean = sn_count > 0 and sn_sum / sn_count or f[3] / area
-  sn_sum, sn_count = 0, 0
+  local impulse, now = world:group_impulse(top)[3], world:time()
+  local sn_mean = now > last_time and ((impulse - last_impulse) / (now - last_time) - applied_z) / area or f[3] / area
+  last_impulse, last_time = impulse, now
   -- Work of the agent on the specimen: the force it applies is minus the particles' force.
   shear_work = shear_work - 0.5 * (f[axis] + last_force[axis]) * (p[axis] - last_pos[axis])
   dilatancy_work = dilatancy_work - 0.5 * (f[3] + last_force[3]) * (p[3] - last_pos[3])
@@ -463,6 +469,9 @@ local function record_shear()
   local c = between()
   local tau = f[axis] / area   -- the lower half resists the upper one moving along -axis
   local e = world:energies()
+  if e.kinetic / energy_scale > dynamic_ratio then dynamic_ratio, dynamic_at = e.kinetic / energy_scale, displacement() end
+  shear_impulse[#shear_impulse + 1] = world:group_impulse(top)[axis]
+  shear_time[#shear_time + 1], shear_disp[#shear_disp + 1] = now, displacement()
   shear:record(displacement(), tau, mpa(tau), mpa(f[3] / area), mpa(sn_mean), (p[3] - c0[3]) * 1e3, c.count,
                100 * c.area / area, world:break_count(), mpa(c.flagged_force[axis] / area),
                e.kinetic, e.strain - e0.strain, e.friction - e0.friction, e.damping - e0.damping,
@@ -481,10 +490,19 @@ end
 record_shear()
 local record_every = math.max(1, math.floor(P.record * 1e-3 / (P.velocity * world:dt()) + 0.5))
 local shear_t0, shear_s0 = asperity.wall_time(), world:step()
-world:run{steps = 100000000, every = 1, progress = P.progress,
-          callback = function(w)
-            sample_normal()
-            if w:step() % record_every == 0 then record_shear() end
+-- The shear velocity rises linearly over `ramp` mm (time 2 ramp / v), in one stage per record.
+local ramp_stages = P.ramp > 0 and math.max(1, math.ceil(2 * P.ramp * 1e-3 / P.velocity / world:dt() / record_every)) or 1
+local function set_shear_velocity(stage)
+  local v = {0, 0, 0}
+  v[axis] = -P.velocity * math.min(1, stage / ramp_stages)
+  world:set_group_motion(top, {translation = modes, velocity = v})
+end
+set_shear_velocity(1)
+local stage = 1
+world:run{steps = 100000000, every = record_every, progress = P.progress,
+          callback = function()
+            record_shear()
+            if stage < ramp_stages then stage = stage + 1; set_shear_velocity(stage) end
           end,
           stop_when = function() return displacement() >= P.shear end,
           fraction = function() return displacement() / P.shear end,
@@ -504,9 +522,24 @@ local cnt = shear:column("contacts")
 local rows = shear:rows()
 local peak, at = -math.huge, 1
 for k = 1, rows do if tau[k] > peak then peak, at = tau[k], k end end
-local residual, m = 0, 0
-for k = 1, rows do if u[k] >= u[rows] - 0.5 then residual, m = residual + tau[k], m + 1 end end
-residual = residual / math.max(m, 1)
+-- Residual: the mean shear stress over the last 0.5 mm, from the platen's impulse (the exact time
+-- mean, so it does not depend on the record interval; at constant velocity time and displacement
+-- means agree).
+local residual
+do
+  local last, first = #shear_disp, #shear_disp
+  while first > 1 and shear_disp[first - 1] >= shear_disp[last] - 0.5 do first = first - 1 end
+  if first < last and shear_time[last] > shear_time[first] then
+    residual = mpa((shear_impulse[last] - shear_impulse[first]) / (shear_time[last] - shear_time[first]) / area)
+  else
+    residual = tau[rows]
+  end
+end
+if dynamic_ratio > P.quasi_static_limit then
+  log("WARNING: not quasi-static: the kinetic energy reached %.3g x (normal load x mean radius) at %.3f mm "
+      .. "(limit quasi_static_limit = %g); results depend on the loading rate: lower velocity (now %g m/s)",
+      dynamic_ratio, dynamic_at, P.quasi_static_limit, P.velocity)
+end
 -- Initial shear stiffness: slope over the first 30 % of the peak stress.
 local sx, sy = {}, {}
 for k = 1, at do if tau[k] <= 0.3 * peak then sx[#sx + 1] = u[k]; sy[#sy + 1] = tau[k] end end
@@ -555,6 +588,9 @@ local summary = {
   peak_shear_stress_mpa = peak,
   peak_displacement_mm = u[at],
   residual_shear_stress_mpa = residual,
+  kinetic_ratio_max = dynamic_ratio,         -- max Ek / (normal load x mean radius) while shearing
+  kinetic_ratio_max_at_mm = dynamic_at,
+  quasi_static = dynamic_ratio <= P.quasi_static_limit,
   initial_shear_stiffness_mpa_per_mm = ks,
   max_dilatancy_mm = max_dil,
   dilatancy_angle_at_peak_deg = math.deg(math.atan(slope_at(at))),

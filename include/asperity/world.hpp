@@ -68,7 +68,8 @@ enum class Dof : std::uint8_t { free, fixed, velocity, servo };
 // v = clamp(G (F - F_target), -max_velocity, max_velocity), where F is the force the particles
 // exert on the group along the axis. With stiffness > 0 (constant normal stiffness, CNS) the
 // target follows the displacement since the servo was engaged: F_target = target_force +
-// stiffness * displacement. Sign convention: a top platen pressing down feels F > 0, so its
+// stiffness * displacement (setting the motion again with the same target, stiffness and integral
+// time keeps that origin and the integral, so the other axes can change on the fly). Sign convention: a top platen pressing down feels F > 0, so its
 // target is positive; a bottom platen's is negative.
 struct Servo {
   double target_force = 0;    // N

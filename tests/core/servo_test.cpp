@@ -168,6 +168,43 @@ TEST(Servo, GainFollowsTheContactsOfEveryStep) {
   EXPECT_LT(worst, 1e-3) << "settled within 60 steps and held";
 }
 
+// Setting the motion again with the servo unchanged (as a shear test does when it changes the
+// shear velocity) keeps the integral: the platen on a sinking floor stays on its target. Changing
+// the target restarts it.
+TEST(Servo, ResettingAnUnchangedServoKeepsItsIntegral) {
+  const double target = 2e-5, u = 3e-5;
+  WorldSettings ws;
+  ws.rotation = false;
+  ws.dt = 1e-3;
+  World w(ws);
+  const int floor = w.add_plane({0, 0, 0}, {0, 0, 1});
+  std::vector<std::int64_t> members;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j) members.push_back(w.add_particle({i * 2.2 * kR, j * 2.2 * kR, 0.99 * kR}, kR));
+  GroupMotion m = servo_z(target);
+  m.servo[2].integral_time = 2 * ws.dt;
+  m.translation[0] = Dof::velocity;  // x: the "shear" axis, velocity changed below
+  const int platen = w.add_group(members, m);
+  w.set_wall_velocity(floor, {0, 0, -u});
+  w.cycle(20000);
+  auto worst_after = [&](const GroupMotion& again) {
+    w.set_group_motion(platen, again);
+    double worst = 0;
+    for (int k = 0; k < 50; ++k) {
+      w.cycle(1);
+      worst = std::max(worst, std::fabs(w.group_force(platen).z / again.servo[2].target_force - 1));
+    }
+    return worst;
+  };
+  GroupMotion same = m;
+  same.velocity = {1e-6, 0, 0};
+  EXPECT_LT(worst_after(same), 1e-6) << "integral kept";
+  GroupMotion other = same;
+  other.servo[2].target_force = 1.001 * target;
+  w.cycle(100);
+  EXPECT_GT(worst_after(other), 1e-3) << "a new target starts the integral again (lag u / G > 1 %)";
+}
+
 TEST(Servo, BadServoParametersAreRefused) {
   GroupMotion m = servo_z(1e-5);
   m.servo[2].max_velocity = 0;
