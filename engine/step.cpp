@@ -100,6 +100,31 @@ void check_energy(State& s) {
   }
 }
 
+// Contacts too soft for the load: an overlap as deep as the smaller radius means one centre is
+// (nearly) inside the other particle, where the linear contact law [3-5] and the contact point
+// [3-11] mean nothing. Checked every dt_interval steps with the time-step estimate.
+void check_overlaps(State& s) {
+  const ParticleStore& p = s.p;
+  double worst = 0;
+  std::int64_t worst_i = -1;
+  for (std::size_t k = 0; k < s.pairs.n; ++k) {
+    const double U = s.pairs.overlap[k];
+    if (!(U > 0)) continue;
+    const auto a = s.pairs.a[k], b = s.pairs.b[k];
+    const double r = U / std::min(p.radius[a], p.radius[b]);
+    if (r > worst) worst = r, worst_i = p.radius[a] <= p.radius[b] ? a : b;
+  }
+  const WallContacts& wc = s.walls.contacts;
+  for (std::size_t k = 0; k < wc.n; ++k) {
+    const double r = wc.overlap[k] / p.radius[wc.particle[k]];
+    if (r > worst) worst = r, worst_i = wc.particle[k];
+  }
+  if (worst > 1.0)
+    health_error(s, "a contact overlap exceeds the particle's radius: the contacts are too soft for "
+                    "the load (raise kn, or lower the load or the loading rate)",
+                 worst_i, "overlap / R", worst);
+}
+
 }  // namespace
 
 double estimate_critical_dt(const State& s) {
@@ -225,7 +250,10 @@ void step_once(State& s) {
   bookkeep(s);
   process_breaks(s);  // after the step: broken bonds acted with the forces of their last state
   s.kinetic_valid = true;
-  if (estimate_due) check_energy(s);
+  if (estimate_due) {
+    check_overlaps(s);
+    check_energy(s);
+  }
 }
 
 }  // namespace asperity::detail

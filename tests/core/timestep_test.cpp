@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "asperity/world.hpp"
 #include "core/report.hpp"
@@ -130,5 +131,38 @@ TEST(TimeStep, DampingRatioOfOneDegreeOfFreedom) {
     for (std::size_t k = 1; k < extrema.size(); ++k)
       EXPECT_NEAR(std::fabs(extrema[k] / extrema[k - 1]), expected, 2e-3)
           << "alpha " << alpha << " extremum " << k;
+  }
+}
+
+// An overlap deeper than the smaller radius: the linear contact law is used outside any sense.
+// Two rigid bodies driven into each other (no dynamics, so no other check fires first) are
+// reported once the overlap passes the radius, and not before.
+TEST(Health, AnOverlapDeeperThanTheRadiusIsReported) {
+  const double R = 1e-3;
+  WorldSettings ws;
+  ws.rotation = false;
+  ws.dt = 1e-5;
+  ws.contact.kn = 1e3;
+  ws.contact.ks = 1e2;
+  World w(ws);
+  const auto a = w.add_particle({0, 0, 0}, R);
+  const auto b = w.add_particle({2 * R, 0, 0}, R);  // touching
+  GroupMotion fixed;
+  fixed.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
+  const std::vector<std::int64_t> ga{a}, gb{b};
+  w.add_group(ga, fixed);
+  GroupMotion push = fixed;
+  push.translation = {Dof::velocity, Dof::fixed, Dof::fixed};
+  push.velocity = {-1e-2, 0, 0};  // 1e-7 m = 1e-4 R per step
+  w.add_group(gb, push);
+  EXPECT_NO_THROW(w.cycle(9500)) << "overlap 0.95 R: still accepted";
+  try {
+    w.cycle(2000);
+    FAIL() << "an overlap beyond the radius must be reported";
+  } catch (const HealthError& e) {
+    EXPECT_EQ(e.quantity, "overlap / R");
+    EXPECT_GT(e.value, 1.0);
+    EXPECT_LT(e.value, 1.02) << "found within one check interval (100 steps = 0.01 R)";
+    EXPECT_NE(std::string(e.what()).find("too soft"), std::string::npos);
   }
 }
