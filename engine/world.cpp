@@ -476,9 +476,8 @@ void World::set_group_motion(int group, const GroupMotion& motion) {
                       a.target_force == b.target_force && a.stiffness == b.stiffness &&
                       a.integral_time == b.integral_time;
     if (!same) {
-      auto at = [k](Vec3& v) -> double& { return k == 0 ? v.x : (k == 1 ? v.y : v.z); };
-      at(g.servo_origin) = g.centre[k];
-      at(g.servo_integral) = 0;
+      g.servo_origin[k] = g.centre[k];
+      g.servo_integral[k] = 0;
     }
   }
   g.motion = motion;

@@ -150,12 +150,9 @@ local function build_specimen()
       packed.steps, packed.seconds, packed.porosity_nominal, packed.porosity_true, packed.ratio,
       packed.reached and "" or (" (not below 1e-4 within pack_steps = %d)"):format(P.pack_steps))
   -- Mean compressive stress on the box walls: what the bonds will lock in once the walls go.
-  local faces = {Ly * 2 * T, Ly * 2 * T, Lx * 2 * T, Lx * 2 * T, Lx * Ly, Lx * Ly}
-  local axis_of = {1, 1, 2, 2, 3, 3}
-  local wall_stress = 0
-  for k, p in ipairs(planes) do
-    wall_stress = wall_stress + math.abs(w:wall_force(p)[axis_of[k]]) / faces[k] / #planes
-  end
+  local box = {x_min = planes[1], x_max = planes[2], y_min = planes[3], y_max = planes[4],
+               bottom = planes[5], top = planes[6]}
+  local wall_stress = pack.mean_box_wall_stress(w, box, {0, 0, -T}, {Lx, Ly, T})
   log("mean wall stress after packing %.3g Pa", wall_stress)
   -- Halves by side of the mould; tags 1 (lower) and 2 (upper). A particle squeezed out of the
   -- box during the expansion (a small one between two growing ones can be shot through a wall)
@@ -409,7 +406,7 @@ shear_velocity[axis] = -P.velocity
 -- weight, undamped (local damping would bias the load it transmits by alpha times the mean force
 -- noise): it follows any dilatancy at once and the load it transmits differs from the target only
 -- by its inertia. "servo" (model.md 7): the platen's z velocity follows the force error, with
--- integral action (servo_integral_time) so that a steady dilatancy rate leaves no lag.
+-- integral action (servo_integral_steps) so that a steady dilatancy rate leaves no lag.
 local modes = {"fixed", "fixed", P.normal_control == "servo" and "servo" or "free"}
 modes[axis] = "velocity"
 if P.normal_control == "servo" then
@@ -460,12 +457,12 @@ local last_impulse, last_time = world:group_impulse(top)[3], world:time()
 -- loading rate too high for the material shows up here long before the health checks.
 local dynamic_ratio, dynamic_at = 0, 0
 local energy_scale = target_stress * area * mat.packing.mean_radius
-local shear_impulse, shear_time, shear_disp = {}, {}, {}
+local shear_impulse = {}   -- platen impulse along the shear axis, one per record
 local function record_shear()
   local p, f = world:group_position(top), platen_force()
-  local impulse, now = world:group_impulse(top)[3], world:time()
-  local sn_mean = now > last_time and ((impulse - last_impulse) / (now - last_time) - applied_z) / area or f[3] / area
-  last_impulse, last_time = impulse, now
+  local impulse, now = world:group_impulse(top), world:time()
+  local sn_mean = now > last_time and ((impulse[3] - last_impulse) / (now - last_time) - applied_z) / area or f[3] / area
+  last_impulse, last_time = impulse[3], now
   -- Work of the agent on the specimen: the force it applies is minus the particles' force.
   shear_work = shear_work - 0.5 * (f[axis] + last_force[axis]) * (p[axis] - last_pos[axis])
   dilatancy_work = dilatancy_work - 0.5 * (f[3] + last_force[3]) * (p[3] - last_pos[3])
@@ -474,8 +471,7 @@ local function record_shear()
   local tau = f[axis] / area   -- the lower half resists the upper one moving along -axis
   local e = world:energies()
   if e.kinetic / energy_scale > dynamic_ratio then dynamic_ratio, dynamic_at = e.kinetic / energy_scale, displacement() end
-  shear_impulse[#shear_impulse + 1] = world:group_impulse(top)[axis]
-  shear_time[#shear_time + 1], shear_disp[#shear_disp + 1] = now, displacement()
+  shear_impulse[#shear_impulse + 1] = impulse[axis]
   shear:record(displacement(), tau, mpa(tau), mpa(f[3] / area), mpa(sn_mean), (p[3] - c0[3]) * 1e3, c.count,
                100 * c.area / area, world:break_count(), mpa(c.flagged_force[axis] / area),
                e.kinetic, e.strain - e0.strain, e.friction - e0.friction, e.damping - e0.damping,
@@ -536,10 +532,11 @@ for k = 1, rows do if tau[k] > peak then peak, at = tau[k], k end end
 -- means agree).
 local residual
 do
-  local last, first = #shear_disp, #shear_disp
-  while first > 1 and shear_disp[first - 1] >= shear_disp[last] - 0.5 do first = first - 1 end
-  if first < last and shear_time[last] > shear_time[first] then
-    residual = mpa((shear_impulse[last] - shear_impulse[first]) / (shear_time[last] - shear_time[first]) / area)
+  local time = shear:column("time")
+  local first = rows
+  while first > 1 and u[first - 1] >= u[rows] - 0.5 do first = first - 1 end
+  if first < rows and time[rows] > time[first] then
+    residual = mpa((shear_impulse[rows] - shear_impulse[first]) / (time[rows] - time[first]) / area)
   else
     residual = tau[rows]
   end

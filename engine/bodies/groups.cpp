@@ -73,25 +73,18 @@ void advance_groups(State& s) {
             const double shift = grp.centre[k] - grp.servo_origin[k];
             const double target = sv.target_force + sv.stiffness * shift;
             const double error = Fk[k] - target;
-            double gain = 0;
-            if (sv.gain > 0) gain = sv.gain;
-            // A body out of contact counts as meeting one contact (as in the time-step estimate
-            // [3-30]): it approaches at most `relaxation` x (its force error / kn) per step, so the
-            // first contact cannot be overshot by more than the target load needs.
-            else gain = sv.relaxation / (std::max(grp.contact_stiffness, s.settings.contact.kn) * dt);
-            double v;
-            if (gain > 0) {
-              double& stored = k == 0 ? grp.servo_integral.x : (k == 1 ? grp.servo_integral.y : grp.servo_integral.z);
-              double integral = stored;
-              if (sv.integral_time > 0) {
-                const double trial = integral + error * dt;
-                if (std::fabs(gain * (error + trial / sv.integral_time)) <= sv.max_velocity) integral = trial;
-                stored = integral;
-              }
-              v = gain * (error + (sv.integral_time > 0 ? integral / sv.integral_time : 0.0));
-            } else {
-              v = error > 0 ? sv.max_velocity : (error < 0 ? -sv.max_velocity : 0.0);
+            // Automatic gain: a body out of contact counts as meeting one contact (as in the
+            // time-step estimate [3-30]): it approaches at most `relaxation` x (its force error /
+            // kn) per step, so the first contact cannot be overshot by more than the target load
+            // needs. (kn > 0 and relaxation > 0 are enforced, so the gain is always positive.)
+            const double gain =
+                sv.gain > 0 ? sv.gain : sv.relaxation / (std::max(grp.contact_stiffness, s.settings.contact.kn) * dt);
+            double& integral = grp.servo_integral[k];
+            if (sv.integral_time > 0) {
+              const double trial = integral + error * dt;
+              if (std::fabs(gain * (error + trial / sv.integral_time)) <= sv.max_velocity) integral = trial;
             }
+            const double v = gain * (error + (sv.integral_time > 0 ? integral / sv.integral_time : 0.0));
             Vn[k] = std::clamp(v, -sv.max_velocity, sv.max_velocity);
           } else {
             Vn[k] = grp.motion.translation[k] == Dof::fixed ? 0.0 : Vp[k];

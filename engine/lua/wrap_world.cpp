@@ -1028,22 +1028,11 @@ int world_run(lua_State* L) {
 int world_dt(lua_State* L) {
   return guarded(L, [&] { lua_pushnumber(L, world_arg(L).dt()); return 1; });
 }
-int world_set_dt(lua_State* L) {
+// world:set_dt(x), world:set_dt_safety(x), world:set_skin(x): one number, checked by the World.
+template <void (World::*Set)(double)>
+int set_world_number(lua_State* L) {
   return guarded(L, [&] {
-    World& w = world_arg(L);
-    w.set_dt(check_number(L, 2));
-    return 0;
-  });
-}
-int world_set_dt_safety(lua_State* L) {
-  return guarded(L, [&] {
-    world_arg(L).set_dt_safety(check_number(L, 2));
-    return 0;
-  });
-}
-int world_set_skin(lua_State* L) {
-  return guarded(L, [&] {
-    world_arg(L).set_skin(check_number(L, 2));
+    (world_arg(L).*Set)(check_number(L, 2));
     return 0;
   });
 }
@@ -1309,10 +1298,10 @@ void open_world(lua_State* L) {
        "values to add to it; fraction(world) returns the completion 0..1 for the percent and ETA\n"
        "when stop_when, not steps, ends the run. reason: \"steps\", \"equilibrium\" or \"stop_when\"."},
       {"dt", world_dt, "world:dt() -> s", "The time step in use."},
-      {"set_dt", world_set_dt, "world:set_dt(dt)", "Fixes the time step (0: automatic again)."},
-      {"set_dt_safety", world_set_dt_safety, "world:set_dt_safety(f)",
+      {"set_dt", set_world_number<&World::set_dt>, "world:set_dt(dt)", "Fixes the time step (0: automatic again)."},
+      {"set_dt_safety", set_world_number<&World::set_dt_safety>, "world:set_dt_safety(f)",
        "Automatic time step = f x the critical estimate (default 0.8; 0 < f <= 2)."},
-      {"set_skin", world_set_skin, "world:set_skin(m)", "Verlet skin in m (the list is rebuilt)."},
+      {"set_skin", set_world_number<&World::set_skin>, "world:set_skin(m)", "Verlet skin in m (the list is rebuilt)."},
       {"critical_dt", world_critical_dt, "world:critical_dt() -> s",
        "Critical time step estimate now, without the safety factor."},
       {"step", world_step, "world:step() -> n", "Steps done so far."},

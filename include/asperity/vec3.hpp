@@ -17,6 +17,7 @@ struct Vec3 {
   constexpr Vec3& operator-=(const Vec3& o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
   constexpr bool operator==(const Vec3&) const = default;
   constexpr double operator[](int k) const { return k == 0 ? x : (k == 1 ? y : z); }
+  constexpr double& operator[](int k) { return k == 0 ? x : (k == 1 ? y : z); }
 };
 
 constexpr Vec3 operator*(double s, const Vec3& v) { return v * s; }

@@ -206,7 +206,8 @@ function M.scale(world, first, last, factor)
   M.refresh_dt(world)
 end
 
-local function mean_stress(world, box, lo, hi)
+-- Mean of box_wall_stresses over the walls of `box` (Pa).
+function M.mean_box_wall_stress(world, box, lo, hi)
   local s, n = 0, 0
   for _, v in pairs(M.box_wall_stresses(world, box, lo, hi)) do s, n = s + v, n + 1 end
   return s / n
@@ -242,7 +243,7 @@ function M.install_stress(world, o)
     end}
     steps = steps + n
     iterations = iterations + 1
-    return mean_stress(world, box, lo, hi)
+    return M.mean_box_wall_stress(world, box, lo, hi)
   end
   local function good(p) return math.abs(p - target) <= tol * target end
   local p = stress_at(1)

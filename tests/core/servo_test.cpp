@@ -46,6 +46,28 @@ Column column(GroupMotion motion, bool cover = false) {
   return c;
 }
 
+// A 5 x 5 platen group over a floor plane (its members at height `z`), dt 1e-3 s: the scene of
+// the servo dynamics tests below.
+struct PlatenOnFloor {
+  World w;
+  int floor;
+  int platen;
+};
+
+PlatenOnFloor platen_on_floor(const GroupMotion& motion, double z, int dt_interval = 100) {
+  WorldSettings ws;
+  ws.rotation = false;
+  ws.dt = 1e-3;
+  ws.dt_interval = dt_interval;
+  PlatenOnFloor f{World(ws), -1, -1};
+  f.floor = f.w.add_plane({0, 0, 0}, {0, 0, 1});
+  std::vector<std::int64_t> members;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j) members.push_back(f.w.add_particle({i * 2.2 * kR, j * 2.2 * kR, z}, kR));
+  f.platen = f.w.add_group(members, motion);
+  return f;
+}
+
 GroupMotion servo_z(double target, double stiffness = 0) {
   GroupMotion m;
   m.translation = {Dof::fixed, Dof::fixed, Dof::servo};
@@ -102,17 +124,9 @@ TEST(Servo, ConstantNormalStiffnessTargetFollowsTheDisplacement) {
 TEST(Servo, IntegralActionRemovesTheLagOfASteadyRamp) {
   const double target = 2e-5, u = 3e-5;
   auto run = [&](double integral_steps) {
-    WorldSettings ws;
-    ws.rotation = false;
-    ws.dt = 1e-3;
-    World w(ws);
-    const int floor = w.add_plane({0, 0, 0}, {0, 0, 1});
-    std::vector<std::int64_t> members;
-    for (int i = 0; i < 5; ++i)
-      for (int j = 0; j < 5; ++j) members.push_back(w.add_particle({i * 2.2 * kR, j * 2.2 * kR, 0.99 * kR}, kR));
     GroupMotion m = servo_z(target);
-    m.servo[2].integral_time = integral_steps * ws.dt;
-    const int platen = w.add_group(members, m);
+    m.servo[2].integral_time = integral_steps * 1e-3;
+    auto [w, floor, platen] = platen_on_floor(m, 0.99 * kR);
     w.cycle(20000);  // settle on the target
     w.set_wall_velocity(floor, {0, 0, -u});
     w.cycle(20000);
@@ -147,18 +161,10 @@ TEST(Servo, IntegralActionRemovesTheLagOfASteadyRamp) {
 // +-max_velocity, ringing between 28 % and 102 % of the load (the rigid joint's hold).
 TEST(Servo, GainFollowsTheContactsOfEveryStep) {
   const double target = 2e-5;
-  WorldSettings ws;
-  ws.rotation = false;
-  ws.dt = 1e-3;
-  ws.dt_interval = 1000;  // estimates far apart: the servo must not wait for them
-  World w(ws);
-  w.add_plane({0, 0, 0}, {0, 0, 1});
-  std::vector<std::int64_t> members;
-  for (int i = 0; i < 5; ++i)
-    for (int j = 0; j < 5; ++j) members.push_back(w.add_particle({i * 2.2 * kR, j * 2.2 * kR, kR + 5e-5}, kR));
   GroupMotion m = servo_z(target);
   m.servo[2].max_velocity = 1e-2;  // 1e-5 m per step: more than the 8e-6 m overlap of the target
-  const int platen = w.add_group(members, m);
+  // Estimates (every dt_interval steps) far apart: the servo must not wait for them.
+  auto [w, floor, platen] = platen_on_floor(m, kR + 5e-5, 1000);
   w.cycle(60);  // out of contact for a few steps, then touching
   double worst = 0;
   for (int k = 0; k < 40; ++k) {
@@ -173,18 +179,10 @@ TEST(Servo, GainFollowsTheContactsOfEveryStep) {
 // the target restarts it.
 TEST(Servo, ResettingAnUnchangedServoKeepsItsIntegral) {
   const double target = 2e-5, u = 3e-5;
-  WorldSettings ws;
-  ws.rotation = false;
-  ws.dt = 1e-3;
-  World w(ws);
-  const int floor = w.add_plane({0, 0, 0}, {0, 0, 1});
-  std::vector<std::int64_t> members;
-  for (int i = 0; i < 5; ++i)
-    for (int j = 0; j < 5; ++j) members.push_back(w.add_particle({i * 2.2 * kR, j * 2.2 * kR, 0.99 * kR}, kR));
   GroupMotion m = servo_z(target);
-  m.servo[2].integral_time = 2 * ws.dt;
+  m.servo[2].integral_time = 2e-3;                 // two steps
   m.translation[0] = Dof::velocity;  // x: the "shear" axis, velocity changed below
-  const int platen = w.add_group(members, m);
+  auto [w, floor, platen] = platen_on_floor(m, 0.99 * kR);
   w.set_wall_velocity(floor, {0, 0, -u});
   w.cycle(20000);
   auto worst_after = [&](const GroupMotion& again) {
