@@ -20,6 +20,16 @@ struct Group {
   std::vector<std::int32_t> inert;    // members moved only when read (see World::set_inert)
   Vec3 inert_shift{0, 0, 0};          // group displacement not yet applied to the inert members
   double inert_mass = 0;
+  // A group whose rotation is fixed ("lazy") splits its other members at every neighbour build:
+  // `busy` ones have something acting on them (a pair, bond or wall contact, an applied force) and
+  // are summed and moved every step; the rest are idle (State::idle): their force is zero until
+  // the next build, so they are moved lazily like inert ones. A rigid joint moves its interface,
+  // not its volume (issue 7). Groups that may rotate keep every member busy.
+  bool lazy = false;
+  std::vector<std::int32_t> busy;
+  Vec3 idle_shift{0, 0, 0};  // displacement not yet applied to the idle members
+  double idle_mass = 0;
+  double idle_base = 0;      // bound on the idle members' displacement since the build, before idle_shift
   Vec3 servo_origin{0, 0, 0};         // centre when the motion was set (CNS reference)
   Vec3 servo_integral{0, 0, 0};       // int (F - F_target) dt per servo axis since the motion was set
   double contact_stiffness = 0;       // summed kn of the members' contacts this step (servo gain)
@@ -97,6 +107,11 @@ struct State {
   std::vector<std::uint32_t> group_pairs;
   std::uint64_t group_pairs_at = ~std::uint64_t(0);
 
+  // Idle group members (see Group::busy), per particle index; valid while idle_valid (the split
+  // is redone at every neighbour build and after the API changes motions or applied forces).
+  std::vector<std::uint8_t> idle;
+  bool idle_valid = false;
+
   std::vector<double> pair_block_slip;
   std::vector<ParticleBlockResult> particle_blocks;
 };
@@ -118,7 +133,8 @@ double estimate_critical_dt(const State& s);  // step.cpp
 Energies compute_energies(const State& s);    // step.cpp
 void step_once(State& s);               // step.cpp
 void update_servo_stiffness(State& s);  // bodies/groups.cpp: every step while a servo acts
-void sync_inert(State& s);              // bodies/groups.cpp: bring inert members up to date
+void sync_lazy(State& s);               // bodies/groups.cpp: bring inert and idle members up to date
+void split_idle(State& s);              // bodies/groups.cpp: busy / idle members of lazy groups
 
 // Geometry helpers shared by the wall kernel and the neighbour search (kernels/walls.cpp).
 // Closest point on triangle (a, b, c) to p; `feature`: 0 face, 1..3 vertex a, b, c, 4..6 edge ab,

@@ -58,13 +58,20 @@ void bookkeep(State& s) {
       worst_i = r.worst;
     }
   }
-  // Group members were moved by advance_groups: their displacement counts for the skin too.
-  for (const Group& g : s.groups)
-    for (std::int32_t i : g.members) {
+  // Group members were moved by advance_groups: their displacement counts for the skin too; the
+  // idle ones of a lazy group have moved by at most idle_base + |idle_shift| (split_idle).
+  for (const Group& g : s.groups) {
+    for (std::int32_t i : g.lazy ? g.busy : g.members) {
       const double dx = p.x[i] - p.x0[i], dy = p.y[i] - p.y0[i], dz = p.z[i] - p.z0[i];
       max_disp2 = std::max(max_disp2, dx * dx + dy * dy + dz * dz);
       if (!std::isfinite(p.x[i] + p.y[i] + p.z[i])) health_error(s, "non-finite position", i, "x", p.x[i]);
     }
+    if (g.lazy && g.busy.size() < g.members.size()) {
+      const double d = g.idle_base + norm(g.idle_shift);
+      max_disp2 = std::max(max_disp2, d * d);
+      if (!std::isfinite(d)) health_error(s, "non-finite group displacement", g.members.front(), "x", d);
+    }
+  }
   if (worst_i >= 0 && !std::isfinite(worst))
     health_error(s, "non-finite velocity or position", worst_i, "velocity", worst);
   if (worst > 1.0)
@@ -237,6 +244,7 @@ void step_once(State& s) {
   const bool rebuilt = s.need_rebuild;
   if (rebuilt) build_neighbors(s);
   const bool estimate_due = s.step >= s.last_estimate_step + std::uint64_t(s.settings.dt_interval);
+  if (!s.idle_valid) split_idle(s);
   if (rebuilt || estimate_due || s.dt <= 0) check_dt(s);
   compute_pair_forces(s);
   compute_bond_forces(s);

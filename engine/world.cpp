@@ -52,12 +52,13 @@ void set_mass(detail::ParticleStore& p, std::size_t i) {
 
 void touch(State& s) {  // the user changed the state: rebuild, re-estimate, re-reference energy
   s.need_rebuild = true;
+  s.idle_valid = false;
   s.reference_energy = -1;
   s.kinetic_valid = false;
 }
 
 void recompute_group(State& s, detail::Group& g) {
-  detail::sync_inert(s);
+  detail::sync_lazy(s);
   const auto& p = s.p;
   g.mass = 0;
   g.inert_mass = 0;
@@ -74,12 +75,12 @@ void recompute_group(State& s, detail::Group& g) {
   g.centre = g.mass > 0 ? c / g.mass : Vec3{};
 }
 
-// Inert group members are moved lazily; reads bring them up to date first. This changes no
+// Inert and idle group members are moved lazily; reads bring them up to date first. This changes no
 // observable state, so const readers may do it.
 const State& synced(const State& s) {
   bool pending = false;
-  for (const auto& g : s.groups) pending = pending || !(g.inert_shift == Vec3{});
-  if (pending) detail::sync_inert(const_cast<State&>(s));
+  for (const auto& g : s.groups) pending = pending || !(g.inert_shift == Vec3{}) || !(g.idle_shift == Vec3{});
+  if (pending) detail::sync_lazy(const_cast<State&>(s));
   return s;
 }
 
@@ -296,6 +297,7 @@ void World::set_applied_force(std::int64_t id, Vec3 f) {
   p.ax[i] = f.x;
   p.ay[i] = f.y;
   p.az[i] = f.z;
+  state_->idle_valid = false;  // an idle group member with a force is busy
 }
 void World::set_rotation_locked(std::int64_t id, bool locked) {
   const auto i = index_of(*state_, id);
@@ -480,7 +482,9 @@ void World::set_group_motion(int group, const GroupMotion& motion) {
       g.servo_integral[k] = 0;
     }
   }
+  detail::sync_lazy(*state_);
   g.motion = motion;
+  state_->idle_valid = false;  // a group that may now rotate has no idle members
 }
 const GroupMotion& World::group_motion(int group) const { return state_->groups[check_group(*state_, group)].motion; }
 void World::set_group_applied_force(int group, Vec3 f) {
@@ -503,7 +507,7 @@ std::size_t World::group_count() const { return state_->groups.size(); }
 
 void World::set_inert(std::span<const std::int64_t> ids, bool inert) {
   State& s = *state_;
-  detail::sync_inert(s);
+  detail::sync_lazy(s);
   std::vector<std::size_t> idx;
   for (auto id : ids) {
     const auto i = index_of(s, id);
@@ -775,7 +779,7 @@ void World::rebuild_neighbors() {
 
 // --- measurements --------------------------------------------------------------------------
 
-Energies World::energies() const { return detail::compute_energies(*state_); }
+Energies World::energies() const { return detail::compute_energies(synced(*state_)); }
 
 double World::unbalanced_force_ratio() const {
   const State& s = *state_;

@@ -489,7 +489,7 @@ local function record_shear()
 end
 record_shear()
 local record_every = math.max(1, math.floor(P.record * 1e-3 / (P.velocity * world:dt()) + 0.5))
-local shear_t0, shear_s0 = asperity.wall_time(), world:step()
+local shear_t0, shear_s0, shear_r0 = asperity.wall_time(), world:step(), world:stats().rebuilds
 -- The shear velocity rises linearly over `ramp` mm (time 2 ramp / v), in one stage per record.
 local ramp_stages = P.ramp > 0 and math.max(1, math.ceil(2 * P.ramp * 1e-3 / P.velocity / world:dt() / record_every)) or 1
 local function set_shear_velocity(stage)
@@ -517,6 +517,7 @@ world:run{steps = 100000000, every = record_every, progress = P.progress,
 world:run{steps = 100000000, every = 1, stop_when = function() return displacement() >= P.shear end}
 record_shear()
 local shear_seconds, shear_steps = asperity.wall_time() - shear_t0, world:step() - shear_s0
+local shear_rebuilds = world:stats().rebuilds - shear_r0
 shear:write(P.out .. "/shear")
 log("sheared %.2f mm", displacement())
 
@@ -619,6 +620,7 @@ local summary = {
   energy_balance_error = share(world:energy_balance(e0)),
   steps = world:step(),
   shear_steps = shear_steps,
+  shear_rebuilds = shear_rebuilds,      -- neighbour-list rebuilds while shearing
   shear_seconds = shear_seconds,
   shear_microseconds_per_step = 1e6 * shear_seconds / math.max(shear_steps, 1),  -- cost of one step
   dt = world:dt(),

@@ -36,8 +36,11 @@ void advance_groups(State& s) {
   for (Group& grp : s.groups) {
     if (grp.members.empty()) continue;
     const double alpha = grp.motion.damping >= 0 ? grp.motion.damping : s.settings.local_damping;
+    // Idle members of a lazy group carry no force (split_idle): summing and moving the busy ones
+    // is the whole group.
+    const std::vector<std::int32_t>& moved = grp.lazy ? grp.busy : grp.members;
     Vec3 F = grp.applied, T{0, 0, 0};
-    for (std::int32_t i : grp.members) {
+    for (std::int32_t i : moved) {
       const Vec3 f{p.fx[i], p.fy[i], p.fz[i]};
       const Vec3 r = Vec3{p.x[i], p.y[i], p.z[i]} - grp.centre;
       F += f;
@@ -139,8 +142,9 @@ void advance_groups(State& s) {
     const bool spins = !(Wnew == Vec3{});
     // Inert members: only the shift is recorded; they are moved when someone reads them.
     grp.inert_shift += Vnew * dt;
-    kinetic += 0.5 * grp.inert_mass * dot(Vmid, Vmid);
-    for (std::int32_t i : grp.members) {
+    grp.idle_shift += Vnew * dt;
+    kinetic += 0.5 * (grp.inert_mass + grp.idle_mass) * dot(Vmid, Vmid);
+    for (std::int32_t i : moved) {
       Vec3 r = Vec3{p.x[i], p.y[i], p.z[i]} - old_centre;
       if (spins) r = rotate(r, theta);
       const Vec3 x = grp.centre + r;
@@ -192,21 +196,61 @@ void update_servo_stiffness(State& s) {
   for (std::size_t g = 0; g < s.groups.size(); ++g) s.groups[g].contact_stiffness = K[g];
 }
 
-void sync_inert(State& s) {
+void sync_lazy(State& s) {
   ParticleStore& p = s.p;
   for (Group& g : s.groups) {
-    if (g.inert.empty()) continue;
-    const Vec3 d = g.inert_shift;
-    for (std::int32_t i : g.inert) {
-      p.x[i] += d.x;
-      p.y[i] += d.y;
-      p.z[i] += d.z;
-      p.vx[i] = g.velocity.x;
-      p.vy[i] = g.velocity.y;
-      p.vz[i] = g.velocity.z;
+    if (!g.inert.empty() && !(g.inert_shift == Vec3{})) {
+      const Vec3 d = g.inert_shift;
+      for (std::int32_t i : g.inert) {
+        p.x[i] += d.x; p.y[i] += d.y; p.z[i] += d.z;
+        p.vx[i] = g.velocity.x; p.vy[i] = g.velocity.y; p.vz[i] = g.velocity.z;
+      }
     }
     g.inert_shift = {0, 0, 0};
+    if (g.lazy && !(g.idle_shift == Vec3{})) {
+      const Vec3 d = g.idle_shift;
+      for (std::int32_t i : g.members) {
+        if (!s.idle[i]) continue;
+        p.x[i] += d.x; p.y[i] += d.y; p.z[i] += d.z;
+        p.vx[i] = g.velocity.x; p.vy[i] = g.velocity.y; p.vz[i] = g.velocity.z;
+      }
+      g.idle_base += norm(d);
+    }
+    g.idle_shift = {0, 0, 0};
   }
+}
+
+void split_idle(State& s) {
+  sync_lazy(s);
+  ParticleStore& p = s.p;
+  s.idle.assign(p.n, 0);
+  const Incidence &inc = s.incidence, &binc = s.bond_incidence;
+  const WallContacts& wc = s.walls.contacts;
+  auto acted_on = [&](std::size_t i) {
+    if (inc.start[i + 1] > inc.start[i] || binc.start[i + 1] > binc.start[i] || wc.start[i + 1] > wc.start[i])
+      return true;
+    return p.has_applied && (p.ax[i] != 0 || p.ay[i] != 0 || p.az[i] != 0);
+  };
+  for (Group& g : s.groups) {
+    g.busy.clear();
+    g.idle_mass = 0;
+    g.idle_base = 0;
+    g.lazy = g.motion.rotation == Dof::fixed && g.angular_velocity == Vec3{};
+    if (!g.lazy) continue;
+    for (std::int32_t i : g.members) {
+      if (acted_on(std::size_t(i))) {
+        g.busy.push_back(i);
+        continue;
+      }
+      s.idle[i] = 1;
+      g.idle_mass += p.mass[i];
+      const double dx = p.x[i] - p.x0[i], dy = p.y[i] - p.y0[i], dz = p.z[i] - p.z0[i];
+      g.idle_base = std::max(g.idle_base, std::sqrt(dx * dx + dy * dy + dz * dz));
+      p.fx[i] = p.fy[i] = p.fz[i] = 0;  // what the gather would give it until the next build
+      p.tx[i] = p.ty[i] = p.tz[i] = 0;
+    }
+  }
+  s.idle_valid = true;
 }
 
 }  // namespace asperity::detail

@@ -357,6 +357,7 @@ void World::save(const std::string& path) const {
     Writer w{h, path};
     int version = kCheckpointVersion;
     w.scalar("asperity_checkpoint_version", version);
+    detail::sync_lazy(const_cast<State&>(*state_));  // idle members to where they are (not observable)
     visit(w, const_cast<State&>(*state_));  // the writer only reads
   }
   file.commit();

@@ -413,6 +413,7 @@ void ensure_skin(State& s) {
 
 void build_neighbors(State& s) {
   ParticleStore& p = s.p;
+  sync_lazy(s);  // idle group members are searched: bring them to where they are
   ensure_skin(s);
   CellGrid grid = make_grid(p, s.skin);
   const int every = s.settings.reorder_interval;
@@ -434,6 +435,7 @@ void build_neighbors(State& s) {
   ++s.rebuilds;
   ++s.rebuilds_since_reorder;
   s.need_rebuild = false;
+  split_idle(s);
 }
 
 }  // namespace asperity::detail

@@ -43,6 +43,54 @@ TEST(Groups, PrescribedVelocityIsFollowedExactly) {
   EXPECT_EQ(w.velocity(ids[4]).x, 2e-5);
 }
 
+// A group whose rotation is fixed moves its members that touch nothing lazily (issue 7: a rigid
+// joint moves its interface, not its volume). They must still be found, at their true positions,
+// when something comes within reach: a slab driven into a free sphere gives the same collision as
+// a slab whose rotation is prescribed at zero (every member moved every step), to rounding.
+TEST(Groups, IdleMembersAreFoundWhenSomethingComes) {
+  const double R = 5e-4, v = 1e-3, gap = 2e-4;  // the gap closes after a rebuild (skin 0.4 R)
+  struct Run {
+    std::vector<double> x, vx;  // the sphere, per step
+    std::size_t first_contact = 0;
+    Vec3 member;                // a far member of the slab at the end
+    Vec3 expected;              // where the prescribed motion puts it
+  };
+  auto run = [&](Dof rotation) {
+    World w;
+    const auto ids = slab(w, 3, 0, R);
+    const auto ball = w.add_particle({-2 * R - gap, 0, 0}, R);
+    GroupMotion m;
+    m.translation = {Dof::velocity, Dof::fixed, Dof::fixed};
+    m.velocity = {-v, 0, 0};
+    m.rotation = rotation;  // Dof::velocity at zero angular velocity: never lazy
+    const int g = w.add_group(ids, m);
+    const Vec3 far0 = w.position(ids.back());
+    Run r;
+    for (int k = 1; k <= 400; ++k) {
+      w.cycle(1);
+      if (r.first_contact == 0 && w.contact_count() > 0) r.first_contact = w.step_count();
+      if (k % 100 == 0) {  // reading positions brings idle members up to date: rarely
+        r.x.push_back(w.position(ball).x);
+        r.vx.push_back(w.velocity(ball).x);
+      }
+    }
+    r.member = w.position(ids.back());
+    r.expected = far0 + Vec3{-v * w.time(), 0, 0};
+    EXPECT_EQ(w.group_velocity(g).x, -v);
+    return r;
+  };
+  const Run lazy = run(Dof::fixed), eager = run(Dof::velocity);
+  ASSERT_GT(lazy.first_contact, 0u) << "the slab reached the sphere";
+  EXPECT_EQ(lazy.first_contact, eager.first_contact);
+  for (std::size_t k = 0; k < lazy.x.size(); ++k) {
+    ASSERT_NEAR(lazy.x[k], eager.x[k], 1e-12 * R) << "step " << 100 * (k + 1);
+    ASSERT_NEAR(lazy.vx[k], eager.vx[k], 1e-9 * v) << "step " << 100 * (k + 1);
+  }
+  EXPECT_LT(lazy.vx.back(), -0.5 * v) << "the sphere was pushed along";
+  EXPECT_NEAR(lazy.member.x, lazy.expected.x, 1e-15) << "an idle member read back where the group put it";
+  EXPECT_EQ(lazy.member.y, lazy.expected.y);
+}
+
 TEST(Groups, FreeGroupFallsWithGravityAndPlatenForceIsTheContactSum) {
   WorldSettings ws;
   ws.gravity = {0, 0, -0.01};
