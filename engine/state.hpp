@@ -111,6 +111,10 @@ struct State {
   // is redone at every neighbour build and after the API changes motions or applied forces).
   std::vector<std::uint8_t> idle;
   bool idle_valid = false;
+  // Per particle block (kParticleBlock): whether it holds a free particle (to integrate), and for
+  // the blocks that do not, their busy group members (the only ones the gather has to visit).
+  std::vector<std::uint8_t> block_free;
+  Incidence block_busy;
 
   std::vector<double> pair_block_slip;
   std::vector<ParticleBlockResult> particle_blocks;

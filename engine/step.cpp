@@ -58,19 +58,28 @@ void bookkeep(State& s) {
       worst_i = r.worst;
     }
   }
-  // Group members were moved by advance_groups: their displacement counts for the skin too; the
-  // idle ones of a lazy group have moved by at most idle_base + |idle_shift| (split_idle).
+  // Group members were moved by advance_groups: the largest displacement of each group (its idle
+  // members have moved by at most idle_base + |idle_shift|, split_idle).
+  double first = 0, second = 0;  // the two largest displacements of distinct bodies
+  auto body = [&](double d) {
+    if (d > first) second = first, first = d;
+    else if (d > second) second = d;
+  };
+  if (!(max_disp2 == max_disp2)) first = max_disp2;  // NaN: rebuild, the health check reports it
+  else if (max_disp2 > 0) body(std::sqrt(max_disp2)), body(std::sqrt(max_disp2));  // two free particles
   for (const Group& g : s.groups) {
+    double d2 = 0;
     for (std::int32_t i : g.lazy ? g.busy : g.members) {
       const double dx = p.x[i] - p.x0[i], dy = p.y[i] - p.y0[i], dz = p.z[i] - p.z0[i];
-      max_disp2 = std::max(max_disp2, dx * dx + dy * dy + dz * dz);
+      d2 = std::max(d2, dx * dx + dy * dy + dz * dz);
       if (!std::isfinite(p.x[i] + p.y[i] + p.z[i])) health_error(s, "non-finite position", i, "x", p.x[i]);
     }
+    double d = std::sqrt(d2);
     if (g.lazy && g.busy.size() < g.members.size()) {
-      const double d = g.idle_base + norm(g.idle_shift);
-      max_disp2 = std::max(max_disp2, d * d);
+      d = std::max(d, g.idle_base + norm(g.idle_shift));
       if (!std::isfinite(d)) health_error(s, "non-finite group displacement", g.members.front(), "x", d);
     }
+    body(d);
   }
   if (worst_i >= 0 && !std::isfinite(worst))
     health_error(s, "non-finite velocity or position", worst_i, "velocity", worst);
@@ -80,9 +89,14 @@ void bookkeep(State& s) {
                     "a runaway)",
                  worst_i, "step displacement / R", worst);
 
+  // A pair missed by the last build (farther apart than Ra + Rb + skin) can touch only once its two
+  // bodies have closed `skin` between them, which the two largest displacements of distinct bodies
+  // bound (a free particle is a body of its own: two free particles count the free maximum twice,
+  // the classic skin/2 rule; two rigid bodies of which one stands still may move a whole skin). A
+  // wall contact likewise needs the particle and the wall to close `skin`.
   double wall_move = 0;
   for (const auto& w : s.walls.walls) wall_move = std::max(wall_move, norm(w.displacement - w.displacement_at_build));
-  if (std::sqrt(max_disp2) + wall_move > 0.5 * s.skin) s.need_rebuild = true;
+  if (!(first + second <= s.skin) || !(first + wall_move <= s.skin)) s.need_rebuild = true;
 }
 
 // Runaway energy: with every dissipation term non-negative, Ek + Es can never exceed what it was

@@ -250,6 +250,19 @@ void split_idle(State& s) {
       p.tx[i] = p.ty[i] = p.tz[i] = 0;
     }
   }
+  const std::size_t blocks = (p.n + kParticleBlock - 1) / kParticleBlock;
+  s.block_free.assign(blocks, 0);
+  for (std::size_t i = 0; i < p.n; ++i)
+    if (p.group[i] < 0) s.block_free[i / kParticleBlock] = 1;
+  Incidence& bb = s.block_busy;
+  bb.start.assign(blocks + 1, 0);
+  bb.entry.clear();
+  for (std::size_t blk = 0; blk < blocks; ++blk) {
+    if (!s.block_free[blk])
+      for (std::size_t i = blk * kParticleBlock; i < std::min(p.n, (blk + 1) * kParticleBlock); ++i)
+        if (!p.inert[i] && !s.idle[i]) bb.entry.push_back(std::int64_t(i));
+    bb.start[blk + 1] = std::int32_t(bb.entry.size());
+  }
   s.idle_valid = true;
 }
 

@@ -91,6 +91,37 @@ TEST(Groups, IdleMembersAreFoundWhenSomethingComes) {
   EXPECT_EQ(lazy.member.y, lazy.expected.y);
 }
 
+// Two rigid bodies: a pair missed by a build needs them to close a whole skin between them, so a
+// body approaching a still one may move a whole skin between builds (free particles: skin / 2
+// each), and two approaching bodies half a skin each. Either way the contact must begin on the
+// step the gap closes.
+TEST(Groups, RigidBodiesRebuildWhenTheyHaveClosedTheSkin) {
+  const double R = 5e-4, skin = 2e-4, gap = 1.5 * skin, v = 1e-3;
+  auto approach = [&](double v_lower, std::uint64_t& rebuilds) {
+    World w;
+    w.set_skin(skin);
+    const auto lower = slab(w, 3, 0, R), upper = slab(w, 3, 2 * R + gap, R);
+    GroupMotion up{{Dof::fixed, Dof::fixed, Dof::velocity}}, low = up;
+    up.velocity = {0, 0, -v};
+    low.velocity = {0, 0, v_lower};
+    const int gl = w.add_group(lower, low), gu = w.add_group(upper, up);
+    std::uint64_t closed = 0, first_contact = 0;
+    for (int k = 0; k < 400 && first_contact == 0; ++k) {
+      w.cycle(1);
+      if (w.contact_count() > 0) first_contact = w.step_count(), rebuilds = w.stats().rebuilds;
+      if (closed == 0 && w.group_position(gu).z - w.group_position(gl).z < 2 * R) closed = w.step_count();
+    }
+    // The overlaps a step reports are those of the positions it started from (forces, then
+    // motion): one step after the gap closed.
+    ASSERT_GT(closed, 0u);
+    EXPECT_EQ(first_contact, closed + 1) << "lower body at " << v_lower << " m/s";
+  };
+  std::uint64_t rebuilds = 0;
+  approach(0, rebuilds);
+  EXPECT_EQ(rebuilds, 2u) << "the first build and one after a whole skin (skin / 2 would need three)";
+  approach(v, rebuilds);
+}
+
 TEST(Groups, FreeGroupFallsWithGravityAndPlatenForceIsTheContactSum) {
   WorldSettings ws;
   ws.gravity = {0, 0, -0.01};
