@@ -39,55 +39,71 @@ void gather_and_integrate(State& s) {
       s.dt, s.settings.local_damping, g.x, g.y, g.z};
 
   // One particle's pair, bond and wall contributions, in the fixed order of its incidence lists.
-  auto gather = [&](std::size_t i) {
+  // Raw pointers captured by value: the stores to the force columns cannot make the compiler
+  // reload them (a vector's data pointer reached through a reference can look aliased).
+  const std::int32_t *pstart = inc.start.data(), *bstart = binc.start.data(), *wstart = wc.start.data();
+  const std::int64_t *pentry = inc.entry.data(), *bentry = binc.entry.data();
+  const double *qnx = q.nx.data(), *qny = q.ny.data(), *qnz = q.nz.data(), *qsx = q.fsx.data(),
+               *qsy = q.fsy.data(), *qsz = q.fsz.data(), *qfn = q.fn.data(), *qu = q.overlap.data();
+  const double *bnx = bq.nx.data(), *bny = bq.ny.data(), *bnz = bq.nz.data(), *bsx = bq.fsx.data(),
+               *bsy = bq.fsy.data(), *bsz = bq.fsz.data(), *bfn = bq.fn.data(), *bu = bq.overlap.data(),
+               *bbsx = bq.fbsx.data(), *bbsy = bq.fbsy.data(), *bbsz = bq.fbsz.data(), *bbn = bq.fbn.data(),
+               *bmn = bq.mbn.data(), *bmsx = bq.mbsx.data(), *bmsy = bq.mbsy.data(), *bmsz = bq.mbsz.data();
+  const double *wnx = wc.nx.data(), *wny = wc.ny.data(), *wnz = wc.nz.data(), *wsx = wc.fsx.data(),
+               *wsy = wc.fsy.data(), *wsz = wc.fsz.data(), *wfn = wc.fn.data(), *wu = wc.overlap.data();
+  const double *radius = p.radius.data(), *ax = applied ? p.ax.data() : nullptr,
+               *ay = applied ? p.ay.data() : nullptr, *az = applied ? p.az.data() : nullptr;
+  double *Fx = p.fx.data(), *Fy = p.fy.data(), *Fz = p.fz.data(), *Tx = p.tx.data(), *Ty = p.ty.data(),
+         *Tz = p.tz.data();
+  auto gather = [=](std::size_t i) __attribute__((always_inline)) {  // two call sites: keep it inline
     double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
-    const double R = p.radius[i];
-    for (std::int32_t e = inc.start[i]; e < inc.start[i + 1]; ++e) {
-      const std::int64_t k = inc.entry[e] >> 1;
-      const double sgn = (inc.entry[e] & 1) ? 1.0 : -1.0;
-      const double nx = q.nx[k], ny = q.ny[k], nz = q.nz[k];
-      const double sx = q.fsx[k], sy = q.fsy[k], sz = q.fsz[k], fn = q.fn[k];
+    const double R = radius[i];
+    for (std::int32_t e = pstart[i]; e < pstart[i + 1]; ++e) {
+      const std::int64_t k = pentry[e] >> 1;
+      const double sgn = (pentry[e] & 1) ? 1.0 : -1.0;
+      const double nx = qnx[k], ny = qny[k], nz = qnz[k];
+      const double sx = qsx[k], sy = qsy[k], sz = qsz[k], fn = qfn[k];
       fx += sgn * (fn * nx + sx);
       fy += sgn * (fn * ny + sy);
       fz += sgn * (fn * nz + sz);
-      const double lever = R - 0.5 * q.overlap[k];
+      const double lever = R - 0.5 * qu[k];
       tx -= lever * (ny * sz - nz * sy);
       ty -= lever * (nz * sx - nx * sz);
       tz -= lever * (nx * sy - ny * sx);
     }
-    for (std::int32_t e = binc.start[i]; e < binc.start[i + 1]; ++e) {
+    for (std::int32_t e = bstart[i]; e < bstart[i + 1]; ++e) {
       // Bond: contact bond + parallel bond forces, plus the beam's moments on b (-M on a).
-      const std::int64_t k = binc.entry[e] >> 1;
-      const double sgn = (binc.entry[e] & 1) ? 1.0 : -1.0;
-      const double nx = bq.nx[k], ny = bq.ny[k], nz = bq.nz[k];
-      const double sx = bq.fsx[k] + bq.fbsx[k], sy = bq.fsy[k] + bq.fbsy[k], sz = bq.fsz[k] + bq.fbsz[k];
-      const double fn = bq.fn[k] + bq.fbn[k];
+      const std::int64_t k = bentry[e] >> 1;
+      const double sgn = (bentry[e] & 1) ? 1.0 : -1.0;
+      const double nx = bnx[k], ny = bny[k], nz = bnz[k];
+      const double sx = bsx[k] + bbsx[k], sy = bsy[k] + bbsy[k], sz = bsz[k] + bbsz[k];
+      const double fn = bfn[k] + bbn[k];
       fx += sgn * (fn * nx + sx);
       fy += sgn * (fn * ny + sy);
       fz += sgn * (fn * nz + sz);
-      const double lever = R - 0.5 * bq.overlap[k];
-      tx += sgn * (bq.mbn[k] * nx + bq.mbsx[k]) - lever * (ny * sz - nz * sy);
-      ty += sgn * (bq.mbn[k] * ny + bq.mbsy[k]) - lever * (nz * sx - nx * sz);
-      tz += sgn * (bq.mbn[k] * nz + bq.mbsz[k]) - lever * (nx * sy - ny * sx);
+      const double lever = R - 0.5 * bu[k];
+      tx += sgn * (bmn[k] * nx + bmsx[k]) - lever * (ny * sz - nz * sy);
+      ty += sgn * (bmn[k] * ny + bmsy[k]) - lever * (nz * sx - nx * sz);
+      tz += sgn * (bmn[k] * nz + bmsz[k]) - lever * (nx * sy - ny * sx);
     }
-    for (std::int32_t k = wc.start[i]; k < wc.start[i + 1]; ++k) {
-      const double nx = wc.nx[k], ny = wc.ny[k], nz = wc.nz[k];
-      const double sx = wc.fsx[k], sy = wc.fsy[k], sz = wc.fsz[k], fn = wc.fn[k];
+    for (std::int32_t k = wstart[i]; k < wstart[i + 1]; ++k) {
+      const double nx = wnx[k], ny = wny[k], nz = wnz[k];
+      const double sx = wsx[k], sy = wsy[k], sz = wsz[k], fn = wfn[k];
       fx += fn * nx + sx;
       fy += fn * ny + sy;
       fz += fn * nz + sz;
-      const double lever = R - 0.5 * wc.overlap[k];
+      const double lever = R - 0.5 * wu[k];
       tx -= lever * (ny * sz - nz * sy);
       ty -= lever * (nz * sx - nx * sz);
       tz -= lever * (nx * sy - ny * sx);
     }
     if (applied) {
-      fx += p.ax[i];
-      fy += p.ay[i];
-      fz += p.az[i];
+      fx += ax[i];
+      fy += ay[i];
+      fz += az[i];
     }
-    p.fx[i] = fx; p.fy[i] = fy; p.fz[i] = fz;
-    p.tx[i] = tx; p.ty[i] = ty; p.tz[i] = tz;
+    Fx[i] = fx; Fy[i] = fy; Fz[i] = fz;
+    Tx[i] = tx; Ty[i] = ty; Tz[i] = tz;
   };
 
 #pragma omp parallel for schedule(static) num_threads(thread_count(s))
