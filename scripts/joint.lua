@@ -429,10 +429,11 @@ do
   hold[axis] = "fixed"
   local v0 = {0, 0, 0}
   world:set_group_motion(top, {translation = hold, velocity = v0})
-  world:run{steps = 200000, every = 100, progress = P.progress,
+  local n = world:run{steps = 200000, every = 100, progress = P.progress,
             stop_when = function(w)
               return math.abs(normal_stress() / target_stress - 1) < 0.002 and w:unbalanced_force_ratio() < 1e-3
             end}
+  log("settled on the normal load in %d steps", n)
 end
 local shear = asperity.series{"displacement [mm]", "shear_stress [Pa]", "shear_stress_mpa [MPa]",
   "normal_stress_mpa [MPa]", "normal_stress_mean_mpa [MPa]", "dilatancy [mm]", "contacts [1]", "contact_area [%]",
