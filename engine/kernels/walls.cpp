@@ -191,9 +191,19 @@ void compute_wall_forces(State& s) {
         const double d = norm(dv);
         n = d > 0 ? dv / d : Vec3{0, 0, 1};
         U = p.radius[i] - d;
-        active = feature == 0 || mesh_feature_contact_is_real(mesh, wc.facet[k], feature, q, d);
+        // Only a touching triangle needs the (costly) test of whether a neighbour owns the contact.
+        active = !(U > 0) || feature == 0 || mesh_feature_contact_is_real(mesh, wc.facet[k], feature, q, d);
       }
-      if (!active) U = -1.0;  // not this triangle's contact: no force, history dropped
+      if (!(U > 0) || !active) {
+        // No contact: the law would give no force and forget the shear history [model.md 4]
+        // (exactly: every output is selected to zero), so skip it. A particle near a mesh has
+        // tens of candidate triangles within the skin and touches one to three of them.
+        wc.nx[k] = n.x; wc.ny[k] = n.y; wc.nz[k] = n.z;
+        wc.fsx[k] = wc.fsy[k] = wc.fsz[k] = 0;
+        wc.fn[k] = 0;
+        wc.overlap[k] = active ? U : -1.0;
+        continue;
+      }
       Vec3 o{wc.nx[k], wc.ny[k], wc.nz[k]};
       if (dot(o, o) == 0) o = n;
       double fx = wc.fsx[k], fy = wc.fsy[k], fz = wc.fsz[k], fn;
