@@ -30,6 +30,10 @@ end
 assert(reached and reached <= 0.1, ("half of the level reached at %s mm (from the start: <= 0.1 mm)"):format(tostring(reached)))
 assert(s.peak_shear_stress_mpa <= 2 * s.residual_shear_stress_mpa,
        ("peak %.3g MPa against residual %.3g MPa"):format(s.peak_shear_stress_mpa, s.residual_shear_stress_mpa))
+-- The rigid model closes a joint in a few dozen of its large steps (this one in about 30): the
+-- closure is still recorded finely enough for a normal stiffness.
+assert(s.normal_stiffness_mpa_per_mm == s.normal_stiffness_mpa_per_mm and s.normal_stiffness_mpa_per_mm > 0,
+       "normal stiffness " .. tostring(s.normal_stiffness_mpa_per_mm))
 assert(s.max_dilatancy_mm < 0.25, ("a flat joint dilated %.3g mm (more than half a mean radius)"):format(s.max_dilatancy_mm))
 print(("[figure] flat rigid joint: first mm %.3g MPa, slide %.3g MPa, residual %.3g, peak %.3g MPa at %.2f mm, half level at %.3f mm, dilatancy %.3f mm"):format(
   early, level, s.residual_shear_stress_mpa, s.peak_shear_stress_mpa, s.peak_displacement_mm, reached, s.max_dilatancy_mm))
