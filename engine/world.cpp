@@ -51,8 +51,7 @@ void set_mass(detail::ParticleStore& p, std::size_t i) {
 }
 
 void touch(State& s) {  // the user changed the state: rebuild, re-estimate, re-reference energy
-  s.need_rebuild = true;
-  s.idle_valid = false;
+  s.need_rebuild = true;  // the rebuild also redoes the busy / idle split of the groups
   s.reference_energy = -1;
   s.kinetic_valid = false;
 }
@@ -482,9 +481,8 @@ void World::set_group_motion(int group, const GroupMotion& motion) {
       g.servo_integral[k] = 0;
     }
   }
-  detail::sync_lazy(*state_);
   g.motion = motion;
-  state_->idle_valid = false;  // a group that may now rotate has no idle members
+  state_->idle_valid = false;  // a group that may now rotate has no idle members (the split syncs first)
 }
 const GroupMotion& World::group_motion(int group) const { return state_->groups[check_group(*state_, group)].motion; }
 void World::set_group_applied_force(int group, Vec3 f) {

@@ -120,7 +120,7 @@ void gather_and_integrate(State& s) {
     const std::size_t first = blk * kParticleBlock;
     const std::size_t end = std::min(n, first + kParticleBlock);
     // 0/1 masks for the integrate kernel, written for every particle of the block and zeroed over
-    // the padding lanes beyond n (not zero-initialised: 8 kB per block per step for a rigid body).
+    // the padding lanes beyond n (zero-initialising both would write 8 kB per block per step).
     alignas(64) double free[kParticleBlock], spin[kParticleBlock];
     kernels::IntegrateArgs a = args;
     a.free = free;
