@@ -90,6 +90,7 @@ void bm_pair(benchmark::State& st, int edge, int threads, std::string simd) {
   k.fn = s.pairs.fn.data(); k.overlap = s.pairs.overlap.data();
   k.kn = s.settings.contact.kn; k.ks = s.settings.contact.ks;
   k.friction = s.settings.contact.friction; k.dt = s.dt;
+  k.columns = s.p.capacity;
   const std::size_t total = s.pairs.padded;
   const std::size_t blocks = (total + kPairBlock - 1) / kPairBlock;
   std::vector<double> slip(blocks);

@@ -1,5 +1,6 @@
 // The bond loop shared by the scalar reference and the SIMD kernels (see pair_loop.hpp).
 #pragma once
+#include "kernels/a_side.hpp"
 #include "kernels/bond_law.hpp"
 #include "kernels/kernels.hpp"
 
@@ -14,16 +15,17 @@ double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
   for (std::size_t i = begin; i < end; i += Lanes::size) {
     const auto ia = Lanes::index(k.a + i);
     const auto ib = Lanes::index(k.b + i);
-    const T xa = Lanes::gather(k.x, ia), ya = Lanes::gather(k.y, ia), za = Lanes::gather(k.z, ia);
+    const ASide<Lanes> A(k.a + i, ia, k.columns);
+    const T xa = A.gather(k.x), ya = A.gather(k.y), za = A.gather(k.z);
     const T xb = Lanes::gather(k.x, ib), yb = Lanes::gather(k.y, ib), zb = Lanes::gather(k.z, ib);
-    const T ra = Lanes::gather(k.radius, ia), rb = Lanes::gather(k.radius, ib);
+    const T ra = A.gather(k.radius), rb = Lanes::gather(k.radius, ib);
     T nx, ny, nz, U, la, lb;
     ball_ball_geometry(xa, ya, za, xb, yb, zb, ra, rb, nx, ny, nz, U, la, lb);
-    const T vax = Lanes::gather(k.vx, ia), vay = Lanes::gather(k.vy, ia), vaz = Lanes::gather(k.vz, ia);
+    const T vax = A.gather(k.vx), vay = A.gather(k.vy), vaz = A.gather(k.vz);
     const T vbx = Lanes::gather(k.vx, ib), vby = Lanes::gather(k.vy, ib), vbz = Lanes::gather(k.vz, ib);
     T wax(0.0), way(0.0), waz(0.0), wbx(0.0), wby(0.0), wbz(0.0);
     if constexpr (Rotation) {
-      wax = Lanes::gather(k.wx, ia); way = Lanes::gather(k.wy, ia); waz = Lanes::gather(k.wz, ia);
+      wax = A.gather(k.wx); way = A.gather(k.wy); waz = A.gather(k.wz);
       wbx = Lanes::gather(k.wx, ib); wby = Lanes::gather(k.wy, ib); wbz = Lanes::gather(k.wz, ib);
     }
     const T ox = Lanes::load(k.nx + i), oy = Lanes::load(k.ny + i), oz = Lanes::load(k.nz + i);

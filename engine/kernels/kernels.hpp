@@ -17,6 +17,10 @@ struct PairKernelArgs {
   double* fsx; double* fsy; double* fsz;
   double* fn; double* overlap;
   double kn, ks, friction, dt;
+  // Length of the particle columns. A batch whose a-side particles lie within one lane-width
+  // window [a0, a0 + lanes) that fits in the columns loads them with one contiguous load and a
+  // lane permutation instead of a gather (lists sorted by a make this the common case); 0 never.
+  std::size_t columns = 0;
 };
 
 using PairKernel = double (*)(const PairKernelArgs&, std::size_t begin, std::size_t end);
@@ -36,6 +40,7 @@ struct BondKernelArgs {
   double* mbn; double* mbsx; double* mbsy; double* mbsz;
   double* broken;
   double kn, ks, beam_kn, beam_ks, dt, strength;
+  std::size_t columns = 0;  // as PairKernelArgs::columns
 };
 
 using BondKernel = double (*)(const BondKernelArgs&, std::size_t begin, std::size_t end);

@@ -9,9 +9,14 @@ namespace {
 
 struct ScalarLanes {
   using Real = double;
+  using Index = std::int64_t;
   static constexpr std::size_t size = 1;
   static std::int64_t index(const std::int64_t* p) { return *p; }
   static double gather(const double* col, std::int64_t i) { return col[i]; }
+  // One lane: the window is the particle itself (a_side.hpp).
+  static std::int64_t offsets(std::int64_t i, std::int64_t first) { return i - first; }
+  static bool fits(std::int64_t off) { return off == 0; }
+  static double window(const double* p, std::int64_t) { return *p; }
   static double load(const double* p) { return *p; }
   static void store(double* p, double v) { *p = v; }
   static double sum(double v) { return v; }

@@ -35,6 +35,37 @@ struct SimdLanes {
     return Real::gather(col, i);
 #endif
   }
+  // a_side.hpp: lane offsets from the batch's first a, whether all lie in [0, size), and the
+  // window load permuted by them. SSE has no variable double permutation: it always gathers.
+  static Index offsets(const Index& i, std::int64_t first) { return i - Index(first); }
+  static bool fits(const Index& off) {
+#if defined(__AVX512F__)
+    return _mm512_cmplt_epu64_mask(off, _mm512_set1_epi64(std::int64_t(size))) == 0xFF;
+#elif defined(__AVX2__)
+    const __m256i v = off;
+    const __m256i out = _mm256_or_si256(_mm256_cmpgt_epi64(_mm256_setzero_si256(), v),
+                                        _mm256_cmpgt_epi64(v, _mm256_set1_epi64x(std::int64_t(size) - 1)));
+    return _mm256_testz_si256(out, out);
+#else
+    (void)off;
+    return false;
+#endif
+  }
+  static Real window(const double* p, const Index& off) {
+#if defined(__AVX512F__)
+    return _mm512_permutexvar_pd(off, _mm512_loadu_pd(p));
+#elif defined(__AVX2__)
+    // No 64-bit variable permutation in AVX2: move 32-bit halves, lane j taking elements
+    // 2 off_j and 2 off_j + 1.
+    const __m256i twice = _mm256_slli_epi64(off, 1);
+    const __m256i idx = _mm256_add_epi64(
+        twice, _mm256_slli_epi64(_mm256_add_epi64(twice, _mm256_set1_epi64x(1)), 32));
+    return _mm256_castps_pd(_mm256_permutevar8x32_ps(_mm256_castpd_ps(_mm256_loadu_pd(p)), idx));
+#else
+    (void)off;
+    return Real::load_unaligned(p);  // never called: fits() is false
+#endif
+  }
   static Real load(const double* p) { return Real::load_aligned(p); }
   static void store(double* p, const Real& v) { v.store_aligned(p); }
   static double sum(const Real& v) { return xsimd::hadd(v); }

@@ -249,8 +249,14 @@ TEST(Bonds, InstallingBeforeTheFirstStepKeepsTheSkin) {
   EXPECT_LE(w.stats().rebuilds - before, 2u);
 }
 
-TEST(Bonds, SimdBondKernelEqualsTheScalarReferenceBitwise) {
-  const std::size_t bonds = 2048, n = 2 * bonds;
+// Separate: each bond has its own two particles. Shared: three bonds per a, a sorted like the
+// bond list, so most batches load their a-side as a window (kernels/a_side.hpp); every fifth
+// batch of 8 has scattered a and gathers.
+class SimdBondKernel : public ::testing::TestWithParam<bool> {};
+
+TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
+  const bool shared = GetParam();
+  const std::size_t bonds = 2048, n = 2 * bonds, m = (bonds + 2) / 3;
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(-1, 1);
   AVec<double> x(n), y(n), z(n), vx(n), vy(n), vz(n), wx(n), wy(n), wz(n), r(n);
@@ -261,16 +267,22 @@ TEST(Bonds, SimdBondKernelEqualsTheScalarReferenceBitwise) {
     r[i] = kR * (1 + 0.3 * u(rng));
     vx[i] = 1e-3 * u(rng); vy[i] = 1e-3 * u(rng); vz[i] = 1e-3 * u(rng);
     wx[i] = u(rng); wy[i] = u(rng); wz[i] = u(rng);
+    x[i] = u(rng); y[i] = u(rng); z[i] = u(rng);
   }
   for (std::size_t k = 0; k < bonds; ++k) {
-    a[k] = std::int64_t(2 * k);
-    b[k] = std::int64_t(2 * k + 1);
-    x[2 * k] = u(rng); y[2 * k] = u(rng); z[2 * k] = u(rng);
+    if (shared) {
+      a[k] = std::int64_t((k / 8) % 5 == 4 ? (7 * k) % m : k / 3);
+      b[k] = std::int64_t(m + k);
+    } else {
+      a[k] = std::int64_t(2 * k);
+      b[k] = std::int64_t(2 * k + 1);
+    }
+    const auto ia = std::size_t(a[k]), ib = std::size_t(b[k]);
     Vec3 dir{u(rng), u(rng), u(rng)};
     dir = dir / norm(dir);
-    const double d = (r[2 * k] + r[2 * k + 1]) * (1 + 0.01 * u(rng));
-    x[2 * k + 1] = x[2 * k] + d * dir.x; y[2 * k + 1] = y[2 * k] + d * dir.y; z[2 * k + 1] = z[2 * k] + d * dir.z;
-    rb[k] = std::min(r[2 * k], r[2 * k + 1]);
+    const double d = (r[ia] + r[ib]) * (1 + 0.01 * u(rng));
+    x[ib] = x[ia] + d * dir.x; y[ib] = y[ia] + d * dir.y; z[ib] = z[ia] + d * dir.z;
+    rb[k] = std::min(r[ia], r[ib]);
     hist[0][k] = dir.x; hist[1][k] = dir.y; hist[2][k] = dir.z;
     // Forces ~1e-6 N and moments ~1e-10 N m give stresses ~1 Pa, around the strength of 1 Pa.
     for (int c = 3; c < 12; ++c) hist[c][k] = 1e-6 * u(rng);
@@ -283,7 +295,7 @@ TEST(Bonds, SimdBondKernelEqualsTheScalarReferenceBitwise) {
                                  h[4].data(), h[5].data(), h[6].data(), h[7].data(), h[8].data(),
                                  h[9].data(), h[10].data(), h[11].data(), h[12].data(),
                                  h[13].data(), h[14].data(), h[15].data(), h[17].data(), 0.1,
-                                 0.01, 0.1, 0.01, 1e-3, 1.0};
+                                 0.01, 0.1, 0.01, 1e-3, 1.0, n};
     const double broken = ks.bond(args, 0, bonds);
     return std::make_pair(broken, h);
   };
@@ -298,6 +310,8 @@ TEST(Bonds, SimdBondKernelEqualsTheScalarReferenceBitwise) {
           << arch << " column " << c;
   }
 }
+INSTANTIATE_TEST_SUITE_P(Bonds, SimdBondKernel, ::testing::Values(false, true),
+                         [](const auto& info) { return info.param ? "SharedA" : "SeparateA"; });
 
 TEST(Bonds, BondedBlockIsDeterministicAcrossThreadsAndSurvivesReorders) {
   auto run = [](int threads, int reorder) {

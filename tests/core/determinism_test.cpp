@@ -6,6 +6,7 @@
 #include <limits>
 #include <utility>
 #include <random>
+#include <string>
 
 #include "core/aligned.hpp"
 #include "kernels/kernels.hpp"
@@ -43,12 +44,16 @@ TEST(Determinism, SameSeedSameRun) {
 
 namespace {
 // Random pairs in every state: touching, apart, sliding, sticking, spinning, fresh (zero history).
+// Separate: every pair has its own two particles (a-side gathered). Shared: three pairs per a, a
+// sorted like the engine's lists, so most batches load their a-side as a window (a_side.hpp);
+// every fifth batch of 8 has scattered a and gathers.
 struct RandomPairs {
   std::vector<double, AlignedAllocator<double>> x, y, z, vx, vy, vz, wx, wy, wz, r;
   std::vector<std::int64_t, AlignedAllocator<std::int64_t>> a, b;
   std::vector<double, AlignedAllocator<double>> nx, ny, nz, fsx, fsy, fsz, fn, U;
-  explicit RandomPairs(std::size_t pairs, unsigned seed) {
-    const std::size_t n = 2 * pairs;
+  RandomPairs(std::size_t pairs, unsigned seed, bool shared = false) {
+    const std::size_t m = shared ? (pairs + 2) / 3 : 0;  // a-particles in shared mode
+    const std::size_t n = shared ? m + pairs : 2 * pairs;
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> u(-1, 1);
     for (auto* c : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &r}) c->resize(n);
@@ -56,17 +61,23 @@ struct RandomPairs {
       r[i] = 5e-4 * (1 + 0.3 * u(rng));
       vx[i] = 1e-3 * u(rng); vy[i] = 1e-3 * u(rng); vz[i] = 1e-3 * u(rng);
       wx[i] = u(rng); wy[i] = u(rng); wz[i] = u(rng);
+      x[i] = u(rng); y[i] = u(rng); z[i] = u(rng);
     }
     a.resize(pairs); b.resize(pairs);
     for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &U}) c->resize(pairs);
     for (std::size_t k = 0; k < pairs; ++k) {
-      a[k] = std::int64_t(2 * k);
-      b[k] = std::int64_t(2 * k + 1);
-      x[2 * k] = u(rng); y[2 * k] = u(rng); z[2 * k] = u(rng);
+      if (shared) {
+        a[k] = std::int64_t((k / 8) % 5 == 4 ? (7 * k) % m : k / 3);
+        b[k] = std::int64_t(m + k);
+      } else {
+        a[k] = std::int64_t(2 * k);
+        b[k] = std::int64_t(2 * k + 1);
+      }
+      const auto ia = std::size_t(a[k]), ib = std::size_t(b[k]);
       Vec3 dir{u(rng), u(rng), u(rng)};
       dir = dir / norm(dir);
-      const double d = (r[2 * k] + r[2 * k + 1]) * (1 + 0.05 * u(rng));
-      x[2 * k + 1] = x[2 * k] + d * dir.x; y[2 * k + 1] = y[2 * k] + d * dir.y; z[2 * k + 1] = z[2 * k] + d * dir.z;
+      const double d = (r[ia] + r[ib]) * (1 + 0.05 * u(rng));
+      x[ib] = x[ia] + d * dir.x; y[ib] = y[ia] + d * dir.y; z[ib] = z[ia] + d * dir.z;
       Vec3 old = dir + Vec3{0.01 * u(rng), 0.01 * u(rng), 0.01 * u(rng)};
       old = old / norm(old);
       nx[k] = old.x; ny[k] = old.y; nz[k] = old.z;
@@ -77,7 +88,7 @@ struct RandomPairs {
   kernels::PairKernelArgs args() {
     return {x.data(), y.data(), z.data(), vx.data(), vy.data(), vz.data(), wx.data(), wy.data(),
             wz.data(), r.data(), a.data(), b.data(), nx.data(), ny.data(), nz.data(), fsx.data(),
-            fsy.data(), fsz.data(), fn.data(), U.data(), 0.1, 0.01, 0.5, 1e-3};
+            fsy.data(), fsz.data(), fn.data(), U.data(), 0.1, 0.01, 0.5, 1e-3, x.size()};
   }
 };
 }  // namespace
@@ -88,20 +99,22 @@ TEST(Determinism, SimdKernelsEqualTheScalarReferenceBitwise) {
   ASSERT_EQ(archs.back(), "scalar");
   for (const auto& arch : archs) {
     const auto& simd = kernels::select_kernels(arch);
+    for (bool shared : {false, true})
     for (bool rotation : {true, false}) {
-      RandomPairs ref(pairs, 11), got(pairs, 11);
+      RandomPairs ref(pairs, 11, shared), got(pairs, 11, shared);
       const auto& sk = kernels::scalar_kernels();
       const double slip_ref = (rotation ? sk.pair : sk.pair_norot)(ref.args(), 0, pairs);
       const double slip_got = (rotation ? simd.pair : simd.pair_norot)(got.args(), 0, pairs);
       auto same = [&](const auto& u, const auto& v) {
         return std::memcmp(u.data(), v.data(), pairs * sizeof(double)) == 0;
       };
-      EXPECT_TRUE(same(ref.fn, got.fn)) << arch;
-      EXPECT_TRUE(same(ref.U, got.U)) << arch;
-      EXPECT_TRUE(same(ref.nx, got.nx) && same(ref.ny, got.ny) && same(ref.nz, got.nz)) << arch;
-      EXPECT_TRUE(same(ref.fsx, got.fsx) && same(ref.fsy, got.fsy) && same(ref.fsz, got.fsz)) << arch;
+      const std::string what = arch + (shared ? " shared a" : " separate");
+      EXPECT_TRUE(same(ref.fn, got.fn)) << what;
+      EXPECT_TRUE(same(ref.U, got.U)) << what;
+      EXPECT_TRUE(same(ref.nx, got.nx) && same(ref.ny, got.ny) && same(ref.nz, got.nz)) << what;
+      EXPECT_TRUE(same(ref.fsx, got.fsx) && same(ref.fsy, got.fsy) && same(ref.fsz, got.fsz)) << what;
       // The slip energy is summed per lane first: equal to rounding.
-      EXPECT_NEAR(slip_got, slip_ref, 1e-12 * slip_ref) << arch;
+      EXPECT_NEAR(slip_got, slip_ref, 1e-12 * slip_ref) << what;
       ASSERT_GT(slip_ref, 0.0) << "the random pairs must include slipping contacts";
       std::size_t touching = 0;
       for (double u : ref.U) touching += u > 0;
