@@ -88,6 +88,8 @@ void bm_pair(benchmark::State& st, int edge, int threads, std::string simd) {
   k.nx = s.pairs.nx.data(); k.ny = s.pairs.ny.data(); k.nz = s.pairs.nz.data();
   k.fsx = s.pairs.fsx.data(); k.fsy = s.pairs.fsy.data(); k.fsz = s.pairs.fsz.data();
   k.fn = s.pairs.fn.data(); k.overlap = s.pairs.overlap.data();
+  k.fx = s.pairs.fx.data(); k.fy = s.pairs.fy.data(); k.fz = s.pairs.fz.data();
+  k.cx = s.pairs.cx.data(); k.cy = s.pairs.cy.data(); k.cz = s.pairs.cz.data();
   k.kn = s.settings.contact.kn; k.ks = s.settings.contact.ks;
   k.friction = s.settings.contact.friction; k.dt = s.dt;
   k.columns = s.p.capacity;

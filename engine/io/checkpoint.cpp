@@ -200,6 +200,7 @@ void visit(Io& io, State& s) {
                              {"fsx", &q->fsx}, {"fsy", &q->fsy}, {"fsz", &q->fsz},
                              {"fn", &q->fn}, {"overlap", &q->overlap}})
       io.column(at + "/" + name, *col);
+    q->size_outputs();
   }
 
   // Bonds.
@@ -215,6 +216,7 @@ void visit(Io& io, State& s) {
                            {"mbn", &b.mbn}, {"mbsx", &b.mbsx}, {"mbsy", &b.mbsy},
                            {"mbsz", &b.mbsz}, {"broken", &b.broken}})
     io.column(std::string("bonds/") + name, *col);
+  b.size_outputs();
   io.scalar("bonds/material/beam_kn", b.material.beam_kn);
   io.scalar("bonds/material/beam_ks", b.material.beam_ks);
   io.scalar("bonds/material/radius_factor", b.material.radius_factor);

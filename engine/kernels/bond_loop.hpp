@@ -47,13 +47,23 @@ double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
     }
     Lanes::store(k.nx + i, nx); Lanes::store(k.ny + i, ny); Lanes::store(k.nz + i, nz);
     Lanes::store(k.fsx + i, s.fsx); Lanes::store(k.fsy + i, s.fsy); Lanes::store(k.fsz + i, s.fsz);
-    Lanes::store(k.fn + i, select(real, s.fn, T(0.0)));
+    const T fn = select(real, s.fn, T(0.0));
+    Lanes::store(k.fn + i, fn);
     Lanes::store(k.overlap + i, U);
     Lanes::store(k.fbn + i, s.fbn);
     Lanes::store(k.fbsx + i, s.fbsx); Lanes::store(k.fbsy + i, s.fbsy); Lanes::store(k.fbsz + i, s.fbsz);
     Lanes::store(k.mbn + i, s.mbn);
     Lanes::store(k.mbsx + i, s.mbsx); Lanes::store(k.mbsy + i, s.mbsy); Lanes::store(k.mbsz + i, s.mbsz);
     Lanes::store(k.broken + i, brk);
+    // For the gather (kernels/integrate.cpp), with the operations it would do per side.
+    const T ftot = fn + s.fbn;
+    const T sx = s.fsx + s.fbsx, sy = s.fsy + s.fbsy, sz = s.fsz + s.fbsz;
+    Lanes::store(k.fx + i, ftot * nx + sx); Lanes::store(k.fy + i, ftot * ny + sy);
+    Lanes::store(k.fz + i, ftot * nz + sz);
+    Lanes::store(k.cx + i, ny * sz - nz * sy); Lanes::store(k.cy + i, nz * sx - nx * sz);
+    Lanes::store(k.cz + i, nx * sy - ny * sx);
+    Lanes::store(k.mx + i, s.mbn * nx + s.mbsx); Lanes::store(k.my + i, s.mbn * ny + s.mbsy);
+    Lanes::store(k.mz + i, s.mbn * nz + s.mbsz);
   }
   return Lanes::sum(count);
 }

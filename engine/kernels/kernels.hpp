@@ -16,6 +16,8 @@ struct PairKernelArgs {
   double* nx; double* ny; double* nz;
   double* fsx; double* fsy; double* fsz;
   double* fn; double* overlap;
+  double* fx; double* fy; double* fz;  // outputs for the gather (store/pairs.hpp)
+  double* cx; double* cy; double* cz;
   double kn, ks, friction, dt;
   // Length of the particle columns. A batch whose a-side particles lie within one lane-width
   // window [a0, a0 + lanes) that fits in the columns loads them with one contiguous load and a
@@ -39,6 +41,9 @@ struct BondKernelArgs {
   double* fbn; double* fbsx; double* fbsy; double* fbsz;
   double* mbn; double* mbsx; double* mbsy; double* mbsz;
   double* broken;
+  double* fx; double* fy; double* fz;  // outputs for the gather (store/bonds.hpp)
+  double* cx; double* cy; double* cz;
+  double* mx; double* my; double* mz;
   double kn, ks, beam_kn, beam_ks, dt, strength;
   std::size_t columns = 0;  // as PairKernelArgs::columns
 };

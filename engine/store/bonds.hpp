@@ -28,6 +28,10 @@ struct BondStore {
   AVec<double> mbn;                       // twisting moment (along n)
   AVec<double> mbsx, mbsy, mbsz;          // bending moment
   AVec<double> broken;                    // 1 when the criterion was met this step
+  // For the gather, computed by the SIMD kernel (outputs of the step only, like PairStore's):
+  AVec<double> fx, fy, fz;                // force on b: (fn + fbn) n + fs + fbs
+  AVec<double> cx, cy, cz;                // n x (fs + fbs): torque per lever arm, negated
+  AVec<double> mx, my, mz;                // beam moment on b: mbn n + mbs (on a: its negative)
   BondMaterial material;
   bool any = false;                       // a material was set by a first installation
 
@@ -38,6 +42,11 @@ struct BondStore {
     for (auto* c : {&beam_radius, &nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &overlap, &fbn, &fbsx,
                     &fbsy, &fbsz, &mbn, &mbsx, &mbsy, &mbsz, &broken})
       c->resize(padded);
+    size_outputs();
+  }
+  // The gather's columns are not saved: a store read from a checkpoint sizes them here.
+  void size_outputs() {
+    for (auto* c : {&fx, &fy, &fz, &cx, &cy, &cz, &mx, &my, &mz}) c->resize(padded);
   }
   void fill_padding(std::int64_t null_a, std::int64_t null_b) {
     for (std::size_t i = n; i < padded; ++i) {
@@ -47,6 +56,7 @@ struct BondStore {
       nx[i] = 1;
       ny[i] = nz[i] = fsx[i] = fsy[i] = fsz[i] = fn[i] = overlap[i] = fbn[i] = 0;
       fbsx[i] = fbsy[i] = fbsz[i] = mbn[i] = mbsx[i] = mbsy[i] = mbsz[i] = broken[i] = 0;
+      fx[i] = fy[i] = fz[i] = cx[i] = cy[i] = cz[i] = mx[i] = my[i] = mz[i] = 0;
     }
   }
   // Copy bond o of `from` into slot k of this store.

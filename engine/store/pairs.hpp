@@ -1,7 +1,9 @@
 // Pair store: the Verlet list of ball-ball pairs within the skin, touching or not, sorted by
-// (a, b) current indices with a < b. Per pair it keeps only what the gather cannot derive: the
-// contact normal and the shear force (both are also the history for the next step), the normal
-// force and the overlap. The gather builds force and torques from these eight numbers.
+// (a, b) current indices with a < b. Per pair it keeps the contact normal and the shear force
+// (both are also the history for the next step), the normal force and the overlap; and, for the
+// gather, the pair's force on b and n x Fs, which the SIMD kernel computes eight pairs at a time
+// instead of the scalar gather computing them once per side (outputs of the step only: never
+// carried, copied or saved).
 //
 // Sign convention (model.md 4): n points from a to b; fn, fs act on b; -(fn n + fs) acts on a.
 #pragma once
@@ -20,12 +22,19 @@ struct PairStore {
   AVec<double> fsx, fsy, fsz;  // shear force on b (history)
   AVec<double> fn;             // normal force on b along n (>= 0)
   AVec<double> overlap;        // U = Ra + Rb - d (negative: not touching)
+  AVec<double> fx, fy, fz;     // force on b: fn n + fs (on a: its negative)
+  AVec<double> cx, cy, cz;     // n x fs: the torque on either particle is -(R - U/2) times it
 
   void resize(std::size_t count) {
     n = count;
     padded = round_up(count, kMaxLanes);
     for (auto* c : {&a, &b}) c->resize(padded);
     for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &overlap}) c->resize(padded);
+    size_outputs();
+  }
+  // The gather's columns are not saved: a store read from a checkpoint sizes them here.
+  void size_outputs() {
+    for (auto* c : {&fx, &fy, &fz, &cx, &cy, &cz}) c->resize(padded);
   }
   // Padding entries: pair of two null particles, unit normal along x, no force.
   void fill_padding(std::int64_t null_a, std::int64_t null_b) {
@@ -34,6 +43,7 @@ struct PairStore {
       b[i] = null_b;
       nx[i] = 1;
       ny[i] = nz[i] = fsx[i] = fsy[i] = fsz[i] = fn[i] = 0;
+      fx[i] = fy[i] = fz[i] = cx[i] = cy[i] = cz[i] = 0;
       overlap[i] = -1;
     }
   }

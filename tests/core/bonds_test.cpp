@@ -262,7 +262,7 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
   AVec<double> x(n), y(n), z(n), vx(n), vy(n), vz(n), wx(n), wy(n), wz(n), r(n);
   AVec<std::int64_t> a(bonds), b(bonds);
   AVec<double> rb(bonds);
-  std::vector<AVec<double>> hist(18, AVec<double>(bonds));
+  std::vector<AVec<double>> hist(27, AVec<double>(bonds));  // 18..26: outputs for the gather
   for (std::size_t i = 0; i < n; ++i) {
     r[i] = kR * (1 + 0.3 * u(rng));
     vx[i] = 1e-3 * u(rng); vy[i] = 1e-3 * u(rng); vz[i] = 1e-3 * u(rng);
@@ -294,8 +294,10 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
                                  rb.data(), h[0].data(), h[1].data(), h[2].data(), h[3].data(),
                                  h[4].data(), h[5].data(), h[6].data(), h[7].data(), h[8].data(),
                                  h[9].data(), h[10].data(), h[11].data(), h[12].data(),
-                                 h[13].data(), h[14].data(), h[15].data(), h[17].data(), 0.1,
-                                 0.01, 0.1, 0.01, 1e-3, 1.0, n};
+                                 h[13].data(), h[14].data(), h[15].data(), h[17].data(),
+                                 h[18].data(), h[19].data(), h[20].data(), h[21].data(),
+                                 h[22].data(), h[23].data(), h[24].data(), h[25].data(),
+                                 h[26].data(), 0.1, 0.01, 0.1, 0.01, 1e-3, 1.0, n};
     const double broken = ks.bond(args, 0, bonds);
     return std::make_pair(broken, h);
   };
@@ -305,7 +307,7 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
   for (const auto& arch : available_simd_architectures()) {
     const auto got = run(kernels::select_kernels(arch), hist);
     EXPECT_EQ(got.first, ref.first) << arch;
-    for (int c = 0; c < 18; ++c)
+    for (int c = 0; c < 27; ++c)
       EXPECT_EQ(0, std::memcmp(got.second[c].data(), ref.second[c].data(), bonds * sizeof(double)))
           << arch << " column " << c;
   }

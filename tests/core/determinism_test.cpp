@@ -50,7 +50,7 @@ namespace {
 struct RandomPairs {
   std::vector<double, AlignedAllocator<double>> x, y, z, vx, vy, vz, wx, wy, wz, r;
   std::vector<std::int64_t, AlignedAllocator<std::int64_t>> a, b;
-  std::vector<double, AlignedAllocator<double>> nx, ny, nz, fsx, fsy, fsz, fn, U;
+  std::vector<double, AlignedAllocator<double>> nx, ny, nz, fsx, fsy, fsz, fn, U, fx, fy, fz, cx, cy, cz;
   RandomPairs(std::size_t pairs, unsigned seed, bool shared = false) {
     const std::size_t m = shared ? (pairs + 2) / 3 : 0;  // a-particles in shared mode
     const std::size_t n = shared ? m + pairs : 2 * pairs;
@@ -64,7 +64,8 @@ struct RandomPairs {
       x[i] = u(rng); y[i] = u(rng); z[i] = u(rng);
     }
     a.resize(pairs); b.resize(pairs);
-    for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &U}) c->resize(pairs);
+    for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &U, &fx, &fy, &fz, &cx, &cy, &cz})
+      c->resize(pairs);
     for (std::size_t k = 0; k < pairs; ++k) {
       if (shared) {
         a[k] = std::int64_t((k / 8) % 5 == 4 ? (7 * k) % m : k / 3);
@@ -88,7 +89,8 @@ struct RandomPairs {
   kernels::PairKernelArgs args() {
     return {x.data(), y.data(), z.data(), vx.data(), vy.data(), vz.data(), wx.data(), wy.data(),
             wz.data(), r.data(), a.data(), b.data(), nx.data(), ny.data(), nz.data(), fsx.data(),
-            fsy.data(), fsz.data(), fn.data(), U.data(), 0.1, 0.01, 0.5, 1e-3, x.size()};
+            fsy.data(), fsz.data(), fn.data(), U.data(), fx.data(), fy.data(), fz.data(),
+            cx.data(), cy.data(), cz.data(), 0.1, 0.01, 0.5, 1e-3, x.size()};
   }
 };
 }  // namespace
@@ -113,6 +115,8 @@ TEST(Determinism, SimdKernelsEqualTheScalarReferenceBitwise) {
       EXPECT_TRUE(same(ref.U, got.U)) << what;
       EXPECT_TRUE(same(ref.nx, got.nx) && same(ref.ny, got.ny) && same(ref.nz, got.nz)) << what;
       EXPECT_TRUE(same(ref.fsx, got.fsx) && same(ref.fsy, got.fsy) && same(ref.fsz, got.fsz)) << what;
+      EXPECT_TRUE(same(ref.fx, got.fx) && same(ref.fy, got.fy) && same(ref.fz, got.fz)) << what;
+      EXPECT_TRUE(same(ref.cx, got.cx) && same(ref.cy, got.cy) && same(ref.cz, got.cz)) << what;
       // The slip energy is summed per lane first: equal to rounding.
       EXPECT_NEAR(slip_got, slip_ref, 1e-12 * slip_ref) << what;
       ASSERT_GT(slip_ref, 0.0) << "the random pairs must include slipping contacts";
