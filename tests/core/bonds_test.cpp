@@ -6,6 +6,7 @@
 #include <cstring>
 #include <numbers>
 #include <random>
+#include <tuple>
 
 #include "core/aligned.hpp"
 #include "kernels/kernels.hpp"
@@ -249,14 +250,12 @@ TEST(Bonds, InstallingBeforeTheFirstStepKeepsTheSkin) {
   EXPECT_LE(w.stats().rebuilds - before, 2u);
 }
 
-// Separate: each bond has its own two particles. Shared: three bonds per a, a sorted like the
-// bond list, so most batches load their a-side as a window (kernels/a_side.hpp); every fifth
-// batch of 8 has scattered a and gathers.
+// Param: the shared layout of test::kernel_test_pair (else separate).
 class SimdBondKernel : public ::testing::TestWithParam<bool> {};
 
 TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
   const bool shared = GetParam();
-  const std::size_t bonds = 2048, n = 2 * bonds, m = (bonds + 2) / 3;
+  const std::size_t bonds = 2048, n = 2 * bonds;  // enough for either layout
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(-1, 1);
   AVec<double> x(n), y(n), z(n), vx(n), vy(n), vz(n), wx(n), wy(n), wz(n), r(n);
@@ -270,13 +269,7 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
     x[i] = u(rng); y[i] = u(rng); z[i] = u(rng);
   }
   for (std::size_t k = 0; k < bonds; ++k) {
-    if (shared) {
-      a[k] = std::int64_t((k / 8) % 5 == 4 ? (7 * k) % m : k / 3);
-      b[k] = std::int64_t(m + k);
-    } else {
-      a[k] = std::int64_t(2 * k);
-      b[k] = std::int64_t(2 * k + 1);
-    }
+    std::tie(a[k], b[k]) = test::kernel_test_pair(k, bonds, shared);
     const auto ia = std::size_t(a[k]), ib = std::size_t(b[k]);
     Vec3 dir{u(rng), u(rng), u(rng)};
     dir = dir / norm(dir);

@@ -6,6 +6,7 @@
 #include <limits>
 #include <utility>
 #include <random>
+#include <tuple>
 #include <string>
 
 #include "core/aligned.hpp"
@@ -43,17 +44,14 @@ TEST(Determinism, SameSeedSameRun) {
 }
 
 namespace {
-// Random pairs in every state: touching, apart, sliding, sticking, spinning, fresh (zero history).
-// Separate: every pair has its own two particles (a-side gathered). Shared: three pairs per a, a
-// sorted like the engine's lists, so most batches load their a-side as a window (a_side.hpp);
-// every fifth batch of 8 has scattered a and gathers.
+// Random pairs in every state: touching, apart, sliding, sticking, spinning, fresh (zero history),
+// in either layout of test::kernel_test_pair.
 struct RandomPairs {
   std::vector<double, AlignedAllocator<double>> x, y, z, vx, vy, vz, wx, wy, wz, r;
   std::vector<std::int64_t, AlignedAllocator<std::int64_t>> a, b;
   std::vector<double, AlignedAllocator<double>> nx, ny, nz, fsx, fsy, fsz, fn, U, fx, fy, fz, cx, cy, cz;
   RandomPairs(std::size_t pairs, unsigned seed, bool shared = false) {
-    const std::size_t m = shared ? (pairs + 2) / 3 : 0;  // a-particles in shared mode
-    const std::size_t n = shared ? m + pairs : 2 * pairs;
+    const std::size_t n = shared ? test::a_particles(pairs) + pairs : 2 * pairs;
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> u(-1, 1);
     for (auto* c : {&x, &y, &z, &vx, &vy, &vz, &wx, &wy, &wz, &r}) c->resize(n);
@@ -67,13 +65,7 @@ struct RandomPairs {
     for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &U, &fx, &fy, &fz, &cx, &cy, &cz})
       c->resize(pairs);
     for (std::size_t k = 0; k < pairs; ++k) {
-      if (shared) {
-        a[k] = std::int64_t((k / 8) % 5 == 4 ? (7 * k) % m : k / 3);
-        b[k] = std::int64_t(m + k);
-      } else {
-        a[k] = std::int64_t(2 * k);
-        b[k] = std::int64_t(2 * k + 1);
-      }
+      std::tie(a[k], b[k]) = test::kernel_test_pair(k, pairs, shared);
       const auto ia = std::size_t(a[k]), ib = std::size_t(b[k]);
       Vec3 dir{u(rng), u(rng), u(rng)};
       dir = dir / norm(dir);

@@ -1,10 +1,25 @@
 // Small scenes shared by the core tests.
 #pragma once
+#include <cstdint>
 #include <random>
+#include <utility>
 
 #include "asperity/world.hpp"
 
 namespace asperity::test {
+
+// Particles (a, b) of pair k of `pairs` in the random inputs of the SIMD-vs-scalar kernel tests.
+// Separate: every pair has its own two particles, 2k and 2k + 1 (the a-side is gathered). Shared:
+// three pairs per a, a sorted like the engine's lists, so most batches load their a-side as a
+// window (engine/kernels/a_side.hpp); every fifth batch of 8 has scattered a and gathers. Shared
+// uses a_particles(pairs) + pairs particles, separate 2 pairs.
+inline std::size_t a_particles(std::size_t pairs) { return (pairs + 2) / 3; }
+inline std::pair<std::int64_t, std::int64_t> kernel_test_pair(std::size_t k, std::size_t pairs,
+                                                               bool shared) {
+  if (!shared) return {std::int64_t(2 * k), std::int64_t(2 * k + 1)};
+  const std::size_t m = a_particles(pairs);
+  return {std::int64_t((k / 8) % 5 == 4 ? (7 * k) % m : k / 3), std::int64_t(m + k)};
+}
 
 // `n` spheres of random radius on a jittered grid (no overlaps) in a box of six planes, falling
 // with random velocities, friction and rotation: a busy scene with rebuilds, slips and wall
