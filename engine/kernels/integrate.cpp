@@ -19,6 +19,44 @@
 
 namespace asperity::detail {
 
+namespace {
+// What the gather reads of the pair or the bond list: the incidence of each particle, the
+// kernels' force on b and n x Fs, the overlap for the lever arm, and for bonds the beam moment.
+// Raw pointers held by value: the stores to the force columns cannot make the compiler reload
+// them (a vector's data pointer reached through a reference can look aliased).
+struct GatherColumns {
+  const std::int32_t* start;
+  const std::int64_t* entry;  // (index << 1) | (particle is b)
+  const double *fx, *fy, *fz, *cx, *cy, *cz, *overlap;
+  const double *mx = nullptr, *my = nullptr, *mz = nullptr;  // bonds only
+};
+
+// Adds particle i's contributions from one list to (f, t), in the fixed order of its incidence.
+template <bool Moment>
+inline __attribute__((always_inline)) void add_incidences(const GatherColumns& c, std::size_t i,
+                                                          double R, double& fx, double& fy,
+                                                          double& fz, double& tx, double& ty,
+                                                          double& tz) {
+  for (std::int32_t e = c.start[i]; e < c.start[i + 1]; ++e) {
+    const std::int64_t k = c.entry[e] >> 1;
+    const double sgn = (c.entry[e] & 1) ? 1.0 : -1.0;
+    fx += sgn * c.fx[k];
+    fy += sgn * c.fy[k];
+    fz += sgn * c.fz[k];
+    const double lever = R - 0.5 * c.overlap[k];
+    if constexpr (Moment) {  // the beam's moment acts on b, its negative on a
+      tx += sgn * c.mx[k] - lever * c.cx[k];
+      ty += sgn * c.my[k] - lever * c.cy[k];
+      tz += sgn * c.mz[k] - lever * c.cz[k];
+    } else {
+      tx -= lever * c.cx[k];
+      ty -= lever * c.cy[k];
+      tz -= lever * c.cz[k];
+    }
+  }
+}
+}  // namespace
+
 void gather_and_integrate(State& s) {
   ParticleStore& p = s.p;
   const PairStore& q = s.pairs;
@@ -44,15 +82,13 @@ void gather_and_integrate(State& s) {
       s.dt, s.settings.local_damping, g.x, g.y, g.z};
 
   // One particle's pair, bond and wall contributions, in the fixed order of its incidence lists.
-  // Raw pointers captured by value: the stores to the force columns cannot make the compiler
-  // reload them (a vector's data pointer reached through a reference can look aliased).
-  const std::int32_t *pstart = inc.start.data(), *bstart = binc.start.data(), *wstart = wc.start.data();
-  const std::int64_t *pentry = inc.entry.data(), *bentry = binc.entry.data();
-  const double *qfx = q.fx.data(), *qfy = q.fy.data(), *qfz = q.fz.data(), *qcx = q.cx.data(),
-               *qcy = q.cy.data(), *qcz = q.cz.data(), *qu = q.overlap.data();
-  const double *bfx = bq.fx.data(), *bfy = bq.fy.data(), *bfz = bq.fz.data(), *bcx = bq.cx.data(),
-               *bcy = bq.cy.data(), *bcz = bq.cz.data(), *bmx = bq.mx.data(), *bmy = bq.my.data(),
-               *bmz = bq.mz.data(), *bu = bq.overlap.data();
+  // Raw pointers captured by value (see GatherColumns).
+  const GatherColumns pairs{inc.start.data(), inc.entry.data(), q.fx.data(), q.fy.data(),
+                            q.fz.data(), q.cx.data(), q.cy.data(), q.cz.data(), q.overlap.data()};
+  const GatherColumns bonds{binc.start.data(), binc.entry.data(), bq.fx.data(), bq.fy.data(),
+                            bq.fz.data(), bq.cx.data(), bq.cy.data(), bq.cz.data(),
+                            bq.overlap.data(), bq.mx.data(), bq.my.data(), bq.mz.data()};
+  const std::int32_t* wstart = wc.start.data();
   const double *wnx = wc.nx.data(), *wny = wc.ny.data(), *wnz = wc.nz.data(), *wsx = wc.fsx.data(),
                *wsy = wc.fsy.data(), *wsz = wc.fsz.data(), *wfn = wc.fn.data(), *wu = wc.overlap.data();
   const double *radius = p.radius.data(), *ax = applied ? p.ax.data() : nullptr,
@@ -62,29 +98,8 @@ void gather_and_integrate(State& s) {
   auto gather = [=](std::size_t i) __attribute__((always_inline)) {  // two call sites: keep it inline
     double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
     const double R = radius[i];
-    for (std::int32_t e = pstart[i]; e < pstart[i + 1]; ++e) {
-      const std::int64_t k = pentry[e] >> 1;
-      const double sgn = (pentry[e] & 1) ? 1.0 : -1.0;
-      fx += sgn * qfx[k];
-      fy += sgn * qfy[k];
-      fz += sgn * qfz[k];
-      const double lever = R - 0.5 * qu[k];
-      tx -= lever * qcx[k];
-      ty -= lever * qcy[k];
-      tz -= lever * qcz[k];
-    }
-    for (std::int32_t e = bstart[i]; e < bstart[i + 1]; ++e) {
-      // Bond: contact bond + parallel bond forces, plus the beam's moments on b (-M on a).
-      const std::int64_t k = bentry[e] >> 1;
-      const double sgn = (bentry[e] & 1) ? 1.0 : -1.0;
-      fx += sgn * bfx[k];
-      fy += sgn * bfy[k];
-      fz += sgn * bfz[k];
-      const double lever = R - 0.5 * bu[k];
-      tx += sgn * bmx[k] - lever * bcx[k];
-      ty += sgn * bmy[k] - lever * bcy[k];
-      tz += sgn * bmz[k] - lever * bcz[k];
-    }
+    add_incidences<false>(pairs, i, R, fx, fy, fz, tx, ty, tz);
+    add_incidences<true>(bonds, i, R, fx, fy, fz, tx, ty, tz);  // contact + parallel bond
     for (std::int32_t k = wstart[i]; k < wstart[i + 1]; ++k) {
       const double nx = wnx[k], ny = wny[k], nz = wnz[k];
       const double sx = wsx[k], sy = wsy[k], sz = wsz[k], fn = wfn[k];
