@@ -124,6 +124,7 @@ struct State {
 void build_neighbors(State& s);         // neighbor/build.cpp
 void ensure_skin(State& s);             // neighbor/build.cpp: derive the automatic skin if unset
 void compute_pair_forces(State& s);     // kernels/pairs.cpp
+kernels::PairKernelArgs pair_kernel_args(State& s);  // its kernel's arguments (perf/ reuses them)
 void compute_wall_forces(State& s);     // kernels/walls.cpp
 void compute_bond_forces(State& s);     // kernels/bonds.cpp
 void process_breaks(State& s);          // kernels/bonds.cpp: events, energy, compaction
