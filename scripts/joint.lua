@@ -53,6 +53,8 @@ local P = require("params").defaults{
   gap = 1e-3,              -- m, between the halves while they relax
   platen = 1.5e-3,         -- m, layer of each outer face that forms a platen
   porosity = 0.51,
+  wall_friction = 0.5,     -- of the box walls and the mould while packing (the REV's box: 0; see scripts/README.md)
+  packing_stress = 0,      -- Pa: > 0 installs this wall stress before bonding, as the REV does (0: bond as packed)
   seed = 1,
   pack_steps = 300000,     -- most steps spent cycling the packing towards the ratio 1e-4
   record = 0.01,           -- mm of shear between records
@@ -112,7 +114,8 @@ local T = P.thickness
 -- 2. The specimen: packed, bonded, relaxed halves (cached) ---------------------------------
 local key = ("%s_%s_n%d_h%.6g_T%.6g_p%.4g_s%d_g%.6g_k%d"):format(
   P.surface_file ~= "" and P.surface_file:gsub("[^%w]", "_") or P.surface, "v4", n, h, T,
-  P.porosity, P.seed, P.gap, P.pack_steps)
+  P.porosity, P.seed, P.gap, P.pack_steps) .. (P.wall_friction ~= 0.5 and ("_f%.3g"):format(P.wall_friction) or "") ..
+  (P.packing_stress > 0 and ("_ps%.3g"):format(P.packing_stress) or "")
 local cache_file = P.cache .. "/joint_" .. key .. ".h5"
 local LOWER, UPPER, LOST, POROSITY = 1, 2, 3, 1   -- tags; POROSITY is a flag bit
 
@@ -120,16 +123,17 @@ local function build_specimen()
   local w = asperity.world{material = mat.contact, damping = mat.damping, density = mat.density,
                            threads = P.threads}
   -- Boxes: sides, floor of the lower half, roof of the upper one; the mould between them.
+  local wm = {kn = mat.contact.kn, ks = mat.contact.ks, friction = P.wall_friction}
   local planes = {
-    w:add_plane{point = {0, 0, 0}, normal = {1, 0, 0}},
-    w:add_plane{point = {Lx, 0, 0}, normal = {-1, 0, 0}},
-    w:add_plane{point = {0, 0, 0}, normal = {0, 1, 0}},
-    w:add_plane{point = {0, Ly, 0}, normal = {0, -1, 0}},
-    w:add_plane{point = {0, 0, -T}, normal = {0, 0, 1}},
-    w:add_plane{point = {0, 0, T}, normal = {0, 0, -1}},
+    w:add_plane{point = {0, 0, 0}, normal = {1, 0, 0}, material = wm},
+    w:add_plane{point = {Lx, 0, 0}, normal = {-1, 0, 0}, material = wm},
+    w:add_plane{point = {0, 0, 0}, normal = {0, 1, 0}, material = wm},
+    w:add_plane{point = {0, Ly, 0}, normal = {0, -1, 0}, material = wm},
+    w:add_plane{point = {0, 0, -T}, normal = {0, 0, 1}, material = wm},
+    w:add_plane{point = {0, 0, T}, normal = {0, 0, -1}, material = wm},
   }
   local mesh = heightmap.mesh{heights = heights, nx = nx, ny = ny, dx = h, dy = h, origin = {0, 0, 0}}
-  local mould = w:add_mesh{vertices = mesh.vertices, triangles = mesh.triangles}
+  local mould = w:add_mesh{vertices = mesh.vertices, triangles = mesh.triangles, material = wm}
   -- Particle count from the thesis porosity definition [3-35, 3-36] over both halves.
   local volume = Lx * Ly * 2 * T
   local count = radii_lib.count_for_porosity{volume = volume, porosity = P.porosity,
@@ -155,6 +159,13 @@ local function build_specimen()
                bottom = planes[5], top = planes[6]}
   local wall_stress = pack.mean_box_wall_stress(w, box, {0, 0, -T}, {Lx, Ly, T})
   log("mean wall stress after packing %.3g Pa", wall_stress)
+  if P.packing_stress > 0 then
+    local s = pack.install_stress(w, {first = packed.first, last = packed.last, walls = box, min = {0, 0, -T},
+                                      max = {Lx, Ly, T}, target = P.packing_stress, ratio = 1e-4})
+    log("stress installation: radii x %.5f, wall stress %.4g Pa (target %.4g) after %d iterations, %d steps",
+        s.factor, s.stress, P.packing_stress, s.iterations, s.steps)
+    wall_stress = s.stress
+  end
   -- Halves by side of the mould; tags 1 (lower) and 2 (upper). A particle squeezed out of the
   -- box during the expansion (a small one between two growing ones can be shot through a wall)
   -- belongs to neither half.

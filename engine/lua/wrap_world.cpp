@@ -1302,6 +1302,8 @@ void open_world(lua_State* L) {
       {"set_dt_safety", set_world_number<&World::set_dt_safety>, "world:set_dt_safety(f)",
        "Automatic time step = f x the critical estimate (default 0.8; 0 < f <= 2)."},
       {"set_skin", set_world_number<&World::set_skin>, "world:set_skin(m)", "Verlet skin in m (the list is rebuilt)."},
+      {"set_friction", set_world_number<&World::set_friction>, "world:set_friction(mu)",
+       "Ball-ball Coulomb coefficient from the next step on (walls keep theirs)."},
       {"critical_dt", world_critical_dt, "world:critical_dt() -> s",
        "Critical time step estimate now, without the safety factor."},
       {"step", world_step, "world:step() -> n", "Steps done so far."},

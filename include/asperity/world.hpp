@@ -274,6 +274,7 @@ class World {
   void set_dt(double dt);                 // fix it (0: back to automatic)
   void set_dt_safety(double f);           // automatic dt = f x estimate (0 < f <= 2)
   void set_skin(double skin);             // Verlet skin, m (> 0); the list is rebuilt
+  void set_friction(double mu);           // ball-ball Coulomb coefficient from now on (>= 0)
   double critical_dt();                   // estimate now [3-30..3-32], without safety factor
   std::uint64_t step_count() const;
   double time() const;

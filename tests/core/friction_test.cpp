@@ -57,3 +57,38 @@ TEST(Friction, SlidesAboveTheCoulombLimit) {
   EXPECT_NEAR((v2 - v1) / (t2 - t1), accel, 1e-6 * accel);
   EXPECT_GT(w.energies().friction, 0.0);
 }
+
+TEST(Friction, SetFrictionChangesTheBallBallSlipLimit) {
+  // Sphere B rests on sphere A (fixed), pressed by N along the line of centres and pulled by
+  // T = 0.24 N sideways: it sticks at mu = 0.5 (the undamped shear spring peaks at 2 T < mu N);
+  // after set_friction(0.1) it slides with the contact's shear force at 0.1 Fn. Stiff springs keep
+  // the overlap and the stick displacement far below R, so the geometry stays put.
+  const double k = 100.0;
+  WorldSettings ws;
+  ws.local_damping = 0.0;
+  ws.rotation = false;
+  ws.contact = {k, k, kMu};
+  World w(ws);
+  const std::int64_t a = w.add_particle({0, 0, 0}, kR);
+  const std::int64_t b = w.add_particle({0, 0, 2 * kR - kN / k}, kR);
+  const std::int64_t fixed[] = {a};
+  w.add_group(fixed, GroupMotion{{Dof::fixed, Dof::fixed, Dof::fixed}});
+  const double T = 0.24 * kN;
+  w.set_applied_force(b, {T, 0, -kN});
+  w.set_dt(0.05 * w.critical_dt());
+  w.cycle(2000);
+  EXPECT_LT(w.position(b).x, 2.01 * T / k) << "mu = 0.5 holds T = 0.24 N";
+  EXPECT_EQ(w.energies().friction, 0.0) << "no slip while mu = 0.5";
+  EXPECT_THROW(w.set_friction(-0.1), Error);
+  w.set_friction(0.1);
+  w.cycle(300);
+  const auto c = w.contacts();
+  ASSERT_EQ(c.size(), 1u);
+  const double fs = std::sqrt(c[0].shear_force.x * c[0].shear_force.x +
+                              c[0].shear_force.y * c[0].shear_force.y +
+                              c[0].shear_force.z * c[0].shear_force.z);
+  report("set_friction(0.1): |Fs| [N] vs 0.1 Fn", fs, 0.1 * c[0].normal_force);
+  EXPECT_NEAR(fs, 0.1 * c[0].normal_force, 1e-12 * kN) << "sliding at the new limit";
+  EXPECT_GT(w.velocity(b).x, 0.0);
+  EXPECT_GT(w.energies().friction, 0.0);
+}
