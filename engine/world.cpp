@@ -744,9 +744,11 @@ void World::set_dt_safety(double f) {
   state_->need_rebuild = true;  // a fresh estimate before the next step
 }
 void World::set_friction(double mu) {
-  require(mu >= 0 && std::isfinite(mu), "friction must be >= 0, got " + num(mu));
+  ContactMaterial m = state_->settings.contact;
+  m.friction = mu;
+  check_material(m, "set_friction");
   // Only the slip limit [3-22] changes: a shear force above mu Fn slips at the next step.
-  state_->settings.contact.friction = mu;
+  state_->settings.contact = m;
 }
 void World::set_skin(double skin) {
   require(skin > 0 && std::isfinite(skin), "skin must be > 0 (m), got " + num(skin));

@@ -53,7 +53,7 @@ local P = require("params").defaults{
   gap = 1e-3,              -- m, between the halves while they relax
   platen = 1.5e-3,         -- m, layer of each outer face that forms a platen
   porosity = 0.51,
-  wall_friction = 0.5,     -- of the box walls and the mould while packing (the REV's box: 0; see scripts/README.md)
+  wall_friction = mat.contact.friction, -- of the box walls and the mould while packing (the REV's box: 0; scripts/README.md)
   packing_stress = 0,      -- Pa: > 0 installs this wall stress before bonding, as the REV does (0: bond as packed)
   seed = 1,
   pack_steps = 300000,     -- most steps spent cycling the packing towards the ratio 1e-4
@@ -114,7 +114,7 @@ local T = P.thickness
 -- 2. The specimen: packed, bonded, relaxed halves (cached) ---------------------------------
 local key = ("%s_%s_n%d_h%.6g_T%.6g_p%.4g_s%d_g%.6g_k%d"):format(
   P.surface_file ~= "" and P.surface_file:gsub("[^%w]", "_") or P.surface, "v4", n, h, T,
-  P.porosity, P.seed, P.gap, P.pack_steps) .. (P.wall_friction ~= 0.5 and ("_f%.3g"):format(P.wall_friction) or "") ..
+  P.porosity, P.seed, P.gap, P.pack_steps) .. (P.wall_friction ~= mat.contact.friction and ("_f%.3g"):format(P.wall_friction) or "") ..
   (P.packing_stress > 0 and ("_ps%.3g"):format(P.packing_stress) or "")
 local cache_file = P.cache .. "/joint_" .. key .. ".h5"
 local LOWER, UPPER, LOST, POROSITY = 1, 2, 3, 1   -- tags; POROSITY is a flag bit
@@ -145,7 +145,8 @@ local function build_specimen()
                                          sd = mat.packing.radius_sd, seed = P.seed, normalise_mean = true}
   log("packing %d particles in two halves of %.1f x %.1f mm (surface %s, %d x %d grid)", count,
       Lx * 1e3, Ly * 1e3, P.surface_file ~= "" and P.surface_file or P.surface, nx, ny)
-  local packed = pack.expand(w, {min = {0, 0, -T}, max = {Lx, Ly, T}, radii = r, seed = P.seed,
+  local lo, hi = {0, 0, -T}, {Lx, Ly, T}   -- the box of both halves
+  local packed = pack.expand(w, {min = lo, max = hi, radii = r, seed = P.seed,
                                  volume = volume, progress = P.progress, max_steps = P.pack_steps,
                                  inside = function(x, y, z, rad)
                                    local s = surface_z(x, y)
@@ -157,11 +158,11 @@ local function build_specimen()
   -- Mean compressive stress on the box walls: what the bonds will lock in once the walls go.
   local box = {x_min = planes[1], x_max = planes[2], y_min = planes[3], y_max = planes[4],
                bottom = planes[5], top = planes[6]}
-  local wall_stress = pack.mean_box_wall_stress(w, box, {0, 0, -T}, {Lx, Ly, T})
+  local wall_stress = pack.mean_box_wall_stress(w, box, lo, hi)
   log("mean wall stress after packing %.3g Pa", wall_stress)
   if P.packing_stress > 0 then
-    local s = pack.install_stress(w, {first = packed.first, last = packed.last, walls = box, min = {0, 0, -T},
-                                      max = {Lx, Ly, T}, target = P.packing_stress, ratio = 1e-4})
+    local s = pack.install_stress(w, {first = packed.first, last = packed.last, walls = box, min = lo,
+                                      max = hi, target = P.packing_stress, ratio = 1e-4})
     log("stress installation: radii x %.5f, wall stress %.4g Pa (target %.4g) after %d iterations, %d steps",
         s.factor, s.stress, P.packing_stress, s.iterations, s.steps)
     wall_stress = s.stress
