@@ -1,16 +1,19 @@
--- Run time against error (issue 7): the joint test (scripts/joint.lua) under varied numerical
--- settings, each compared with a reference run at a 4x slower loading rate, a smaller time step
--- and finer records. For each setting: wall time, and the relative error of the peak and residual
--- shear stress and of the maximum dilatancy; settings whose largest error is within `tolerance`
--- are "accepted", and the fastest accepted one is what the joint's defaults should be.
+-- Run time against error (issue 7): the joint test (scripts/joint.lua) or the REV tests
+-- (scripts/rev.lua, scene=rev) under varied numerical settings, each compared with a reference
+-- run at a 4x slower loading rate, a smaller time step and finer records. For each setting: wall
+-- time, and the relative error of each measure (joint: peak and residual shear stress, maximum
+-- dilatancy; REV: Young's modulus, compressive and tensile strength); settings whose largest
+-- error is within `tolerance` are "accepted", and the fastest accepted one is what the scene's
+-- defaults should be.
 --
 --   build/asperity run perf/runtime_vs_error.lua                                  -- the default joint
 --   build/asperity run perf/runtime_vs_error.lua size=0.012 thickness=0.004 shear=2 out=out/rve_small
 --   build/asperity run perf/runtime_vs_error.lua only=reference,default,velocity_x2
+--   build/asperity run perf/runtime_vs_error.lua scene=rev out=out/rve_rev        -- the REV (~15 min)
 --
 -- Writes into `out`: runtime_vs_error.csv (one row per setting, in the order below),
 -- runtime_vs_error.json (the same with names and messages), pareto.png (error against wall time)
--- and one directory per run (the joint's own outputs). A setting the engine refuses (a health
+-- and one directory per run (the scene's own outputs). A setting the engine refuses (a health
 -- check: time step too large, loading too fast) is recorded as refused with its message: that is
 -- the answer wanted from the stress settings, not a failure of the study.
 --
@@ -18,6 +21,7 @@
 -- at velocity x sqrt(f) (t' = t / sqrt f turns m f a = F into m a' = F; local damping and friction
 -- do not depend on rate), so the velocity rows cover it.
 local P = require("params").defaults{
+  scene = "joint",     -- joint | rev
   surface = "S1",
   model = "elastic",
   size = 0.02,
@@ -26,74 +30,128 @@ local P = require("params").defaults{
   stress = 14,
   velocity = 1.5e-5,   -- the joint's default shear velocity, m/s
   record = 0.01,       -- the joint's default record interval, mm
+  rate = 1e-6,         -- the REV's default platen velocity, m/s
+  every = 100,         -- the REV's default steps between records
   tolerance = 0.01,    -- accepted error
   only = "",           -- comma-separated setting names (default: all)
   out = "out/runtime_vs_error",
   cache = "out/cache",
   threads = 0,
 }
+if P.scene ~= "joint" and P.scene ~= "rev" then error("scene must be joint or rev, got '" .. P.scene .. "'") end
 asperity.mkdir(P.out)
 local v, rec = P.velocity, P.record
 
--- name, what it changes, joint parameters. The reference comes first: every error is against it.
-local settings = {
-  {"reference", "velocity / 4, dt 0.5 x estimate, records / 4", {velocity = v / 4, dt_safety = 0.5, record = rec / 4}},
-  {"default", "the joint's defaults", {}},
-  {"velocity_x0.5", "velocity / 2", {velocity = v / 2}},
-  {"velocity_x2", "velocity x 2", {velocity = 2 * v}},
-  {"velocity_x4", "velocity x 4", {velocity = 4 * v}},
-  {"dt_0.5", "dt 0.5 x estimate", {dt_safety = 0.5}},
-  {"dt_0.8", "dt 0.8 x estimate (the engine's default)", {dt_safety = 0.8}},
-  {"skin_0.5", "skin 5e-5 m (about 0.2 R)", {skin = 5e-5}},
-  {"skin_2", "skin 2e-4 m (about 0.8 R)", {skin = 2e-4}},
-  {"record_x0.5", "records every 0.005 mm", {record = rec / 2}},
-  {"record_x5", "records every 0.05 mm", {record = 5 * rec}},
-  -- Stress settings: where results degrade, and whether the engine says so.
-  {"stress_velocity_x10", "velocity x 10", {velocity = 10 * v}},
-  {"stress_dt_1.3", "dt 1.3 x estimate", {dt_safety = 1.3}},
+-- Each scene: its script, the parameters every run gets, the settings (name, what it changes,
+-- parameters; the reference first: every error is against it) and the measures compared.
+local scenes = {
+  joint = {
+    script = "joint.lua",
+    base = {surface = P.surface, model = P.model, size = P.size, thickness = P.thickness,
+            shear = P.shear, stress = P.stress, velocity = P.velocity, record = P.record,
+            cache = P.cache, threads = P.threads, progress = false},
+    settings = {
+      {"reference", "velocity / 4, dt 0.5 x estimate, records / 4", {velocity = v / 4, dt_safety = 0.5, record = rec / 4}},
+      {"default", "the joint's defaults", {}},
+      {"velocity_x0.5", "velocity / 2", {velocity = v / 2}},
+      {"velocity_x2", "velocity x 2", {velocity = 2 * v}},
+      {"velocity_x4", "velocity x 4", {velocity = 4 * v}},
+      {"dt_0.5", "dt 0.5 x estimate", {dt_safety = 0.5}},
+      {"dt_0.8", "dt 0.8 x estimate (the engine's default)", {dt_safety = 0.8}},
+      {"skin_0.5", "skin 5e-5 m (about 0.2 R)", {skin = 5e-5}},
+      {"skin_2", "skin 2e-4 m (about 0.8 R)", {skin = 2e-4}},
+      {"record_x0.5", "records every 0.005 mm", {record = rec / 2}},
+      {"record_x5", "records every 0.05 mm", {record = 5 * rec}},
+      -- Stress settings: where results degrade, and whether the engine says so.
+      {"stress_velocity_x10", "velocity x 10", {velocity = 10 * v}},
+      {"stress_dt_1.3", "dt 1.3 x estimate", {dt_safety = 1.3}},
+    },
+    measures = {{"peak_mpa [MPa]", "peak_shear_stress_mpa"}, {"residual_mpa [MPa]", "residual_shear_stress_mpa"},
+                {"dilatancy_mm [mm]", "max_dilatancy_mm"}},
+    steps = function(r) return r.steps end,
+    title = ("%s %s joint"):format(P.surface, P.model),
+  },
+  rev = {
+    script = "rev.lua",
+    base = {rate = P.rate, every = P.every, tests = "elastic,compression,tension", threads = 1},
+    settings = {
+      {"reference", "rate / 4, dt 0.5 x estimate, records / 4", {rate = P.rate / 4, dt_safety = 0.5, every = math.floor(P.every / 4)}},
+      {"default", "rev.lua's defaults", {}},
+      {"rate_x0.5", "rate / 2", {rate = P.rate / 2}},
+      {"rate_x2", "rate x 2", {rate = 2 * P.rate}},
+      {"rate_x4", "rate x 4", {rate = 4 * P.rate}},
+      {"dt_0.5", "dt 0.5 x estimate", {dt_safety = 0.5}},
+      {"dt_1.0", "dt 1.0 x estimate", {dt_safety = 1.0}},
+      {"record_x0.5", "records every 50 steps", {every = math.floor(P.every / 2)}},
+      {"record_x5", "records every 500 steps", {every = 5 * P.every}},
+      {"stress_rate_x10", "rate x 10", {rate = 10 * P.rate}},
+      {"stress_dt_1.3", "dt 1.3 x estimate", {dt_safety = 1.3}},
+    },
+    measures = {{"young_modulus_pa [Pa]", "young_modulus_pa"}, {"compressive_strength_pa [Pa]", "compressive_strength_pa"},
+                {"tensile_strength_pa [Pa]", "tensile_strength_pa"}},
+    -- Steps of the tests (the packing and bonding are the same in every run).
+    steps = function(r)
+      local n = 0
+      for _, t in pairs(r.elastic or {}) do n = n + (t.steps or 0) end
+      for _, t in pairs(r.fracture or {}) do if type(t) == "table" then n = n + (t.steps or 0) end end
+      return n
+    end,
+    title = "REV",
+  },
 }
+local scene = scenes[P.scene]
+local settings = scene.settings
 local wanted = {}
 for name in P.only:gmatch("[^,]+") do wanted[name] = true end
 if next(wanted) and not wanted.reference then wanted.reference = true end
 
 local function run(name, overrides)
-  local given = {surface = P.surface, model = P.model, size = P.size, thickness = P.thickness,
-                 shear = P.shear, stress = P.stress, velocity = P.velocity, record = P.record,
-                 out = P.out .. "/" .. name, cache = P.cache, threads = P.threads, progress = false}
+  local given = {out = P.out .. "/" .. name}
+  for k, x in pairs(scene.base) do given[k] = x end
   for k, x in pairs(overrides) do given[k] = x end
   params = given
   local t0 = asperity.wall_time()
-  local ok, result = pcall(dofile, asperity.scripts_dir .. "/joint.lua")
+  local ok, result = pcall(dofile, asperity.scripts_dir .. "/" .. scene.script)
   return ok, result, asperity.wall_time() - t0
 end
 
 local rows, ref = {}, nil
-local csv = asperity.series{"setting [1]", "wall_seconds [s]", "steps [1]", "peak_mpa [MPa]",
-  "residual_mpa [MPa]", "dilatancy_mm [mm]", "error_peak [1]", "error_residual [1]",
-  "error_dilatancy [1]", "error_max [1]", "accepted [1]"}
+local columns = {"setting [1]", "wall_seconds [s]", "steps [1]"}
+for _, m in ipairs(scene.measures) do columns[#columns + 1] = m[1] end
+for _, m in ipairs(scene.measures) do columns[#columns + 1] = "error_" .. m[1]:match("^[%w_]+") .. " [1]" end
+columns[#columns + 1] = "error_max [1]"
+columns[#columns + 1] = "accepted [1]"
+local csv = asperity.series(columns)
 local function rel(a, b) return math.abs(a / b - 1) end
 for index, s in ipairs(settings) do
   local name, what, overrides = s[1], s[2], s[3]
   if next(wanted) == nil or wanted[name] then
     io.stderr:write(("[runtime_vs_error] %s: %s\n"):format(name, what))
     local ok, r, seconds = run(name, overrides)
-    local row = {name = name, what = what, wall_seconds = seconds}
+    local row = {name = name, what = what, wall_seconds = seconds, values = {}, errors = {}}
     if not ok then
       row.refused = tostring(r)
       io.stderr:write(("[runtime_vs_error] %s refused: %s\n"):format(name, row.refused:match("[^\n]*")))
     else
-      row.steps, row.peak, row.residual, row.dilatancy = r.steps, r.peak_shear_stress_mpa,
-        r.residual_shear_stress_mpa, r.max_dilatancy_mm
+      row.steps = scene.steps(r)
+      for k, m in ipairs(scene.measures) do row.values[k] = r[m[2]] end
       row.normal_stress_deviation_p95 = r.normal_stress_deviation_p95
       row.energy_balance_error = r.energy_balance_error
       if name == "reference" then ref = row end
       if ref then
-        row.error_peak, row.error_residual = rel(row.peak, ref.peak), rel(row.residual, ref.residual)
-        row.error_dilatancy = rel(row.dilatancy, ref.dilatancy)
-        row.error_max = math.max(row.error_peak, row.error_residual, row.error_dilatancy)
+        local values, errors = {index, seconds, row.steps}, {}
+        row.error_max = 0
+        for k = 1, #scene.measures do
+          row.errors[k] = rel(row.values[k], ref.values[k])
+          row.error_max = math.max(row.error_max, row.errors[k])
+          values[#values + 1] = row.values[k]
+          errors[#errors + 1] = row.errors[k]
+        end
         row.accepted = row.error_max <= P.tolerance
-        csv:record(index, seconds, row.steps, row.peak, row.residual, row.dilatancy, row.error_peak,
-                   row.error_residual, row.error_dilatancy, row.error_max, row.accepted and 1 or 0)
+        for _, e in ipairs(errors) do values[#values + 1] = e end
+        values[#values + 1] = row.error_max
+        values[#values + 1] = row.accepted and 1 or 0
+        csv:record(table.unpack(values))
       end
     end
     if name == "reference" and not ref then error("the reference run failed: " .. tostring(row.refused)) end
@@ -112,18 +170,19 @@ asperity.write_json(P.out .. "/runtime_vs_error.json", {parameters = P, rows = r
   fastest_accepted = fastest and fastest.name or nil})
 pcall(function()
   csv:plot{file = P.out .. "/pareto.png", x = "wall_seconds", y = {"error_max"}, points = true, logy = true,
-           title = ("run time against error, %s %s joint (largest of the peak, residual, dilatancy errors)"):format(
-             P.surface, P.model)}
+           title = ("run time against error, %s (largest error of the measures)"):format(scene.title)}
 end)
 
-print(("%-22s %9s %9s %9s %9s %9s %9s  %s"):format("setting", "wall s", "peak", "residual", "dilat.",
-  "err max", "accepted", "what"))
+local head = ("%-22s %9s"):format("setting", "wall s")
+for _, m in ipairs(scene.measures) do head = head .. (" %12s"):format(m[1]:match("^[%w_]+"):sub(1, 12)) end
+print(head .. ("  %9s %9s  %s"):format("err max", "accepted", "what"))
 for _, row in ipairs(rows) do
   if row.refused then
     print(("%-22s %9.1f %s"):format(row.name, row.wall_seconds, "refused: " .. row.refused:match("[^\n]*")))
   else
-    print(("%-22s %9.1f %9.3f %9.3f %9.3f %9.4f %9s  %s"):format(row.name, row.wall_seconds, row.peak,
-      row.residual, row.dilatancy, row.error_max or 0, tostring(row.accepted), row.what))
+    local line = ("%-22s %9.1f"):format(row.name, row.wall_seconds)
+    for k = 1, #scene.measures do line = line .. (" %12.5g"):format(row.values[k]) end
+    print(line .. ("  %9.4f %9s  %s"):format(row.error_max or 0, tostring(row.accepted), row.what))
   end
 end
 print("fastest within " .. P.tolerance .. ": " .. (fastest and fastest.name or "none"))

@@ -53,6 +53,7 @@ local P = require("params").defaults{
   rate_check = false,
   lock_rotation = true,      -- model.md 2: bonded particles do not rotate
   bond_gap = 0,              -- m, largest gap bonded (0: the engine's default, 1e-3 x mean radius)
+  dt_safety = 0,             -- time step / critical estimate in the tests (0: the engine's 0.8)
   threads = 1,
   out = "out/rev",
 }
@@ -198,6 +199,7 @@ local columns = {"step", "time [s]", "displacement [m]", "axial_stress [Pa]", "s
 local function run_test(checkpoint, name, velocity, o)
   local t0 = asperity.wall_time()
   local w = asperity.load(out .. "/" .. checkpoint .. ".h5", {threads = P.threads})
+  if P.dt_safety > 0 then w:set_dt_safety(P.dt_safety) end
   local meter = specimen.strain_meter(w, gauges)
   local zlo, zhi = mean_z(w, gauges.lower), mean_z(w, gauges.upper)
   local s0 = o.slab and specimen.slab_stress(w, zlo, zhi, area)
