@@ -77,6 +77,9 @@ struct State {
   std::vector<double> bond_block_breaks;
   std::vector<std::uint8_t> user_rotation_locked;  // set by the API; bonds add their own lock
   bool any_rotating = true;  // some particle can rotate: kernels read angular velocities
+  // Some bond was installed stress-free: the pair and bond kernels read rest overlaps (which are
+  // all 0 otherwise, so a world without such bonds never reads the columns). Never reset.
+  bool rest_overlaps = false;
   const kernels::KernelSet* kernels = nullptr;
   int max_threads = 1;
 

@@ -575,7 +575,7 @@ ContactSummary World::contact_summary(int tag_a, int tag_b, std::uint8_t flag_ma
 // --- bonds ---------------------------------------------------------------------------------
 
 std::size_t World::install_bonds(const BondMaterial& material, double tolerance,
-                                 std::span<const std::int64_t> ids) {
+                                 std::span<const std::int64_t> ids, bool stress_free) {
   State& s = *state_;
   require(material.beam_kn > 0 && std::isfinite(material.beam_kn),
           "bond material: beam_kn must be > 0, got " + num(material.beam_kn));
@@ -641,15 +641,19 @@ std::size_t World::install_bonds(const BondMaterial& material, double tolerance,
     merged.b[k] = b;
     merged.beam_radius[k] = material.radius_factor * std::min(p.radius[a], p.radius[b]);  // [3-26]
     merged.nx[k] = dx / d; merged.ny[k] = dy / d; merged.nz[k] = dz / d;
-    // An existing contact's shear force is kept by the contact bond; the beam starts unloaded.
-    merged.fsx[k] = q.fsx[c]; merged.fsy[k] = q.fsy[c]; merged.fsz[k] = q.fsz[c];
+    // An existing contact's forces are kept by the contact bond (model.md 5); stress-free, the
+    // contact bond is unloaded at the current overlap instead. The beam starts unloaded.
+    const double keep = stress_free ? 0.0 : 1.0;
+    merged.fsx[k] = keep * q.fsx[c]; merged.fsy[k] = keep * q.fsy[c]; merged.fsz[k] = keep * q.fsz[c];
     merged.overlap[k] = p.radius[a] + p.radius[b] - d;
-    merged.fn[k] = s.settings.contact.kn * merged.overlap[k];
+    merged.rest[k] = stress_free ? merged.overlap[k] : 0.0;
+    merged.fn[k] = s.settings.contact.kn * (merged.overlap[k] - merged.rest[k]);
     merged.fbn[k] = merged.fbsx[k] = merged.fbsy[k] = merged.fbsz[k] = 0;
     merged.mbn[k] = merged.mbsx[k] = merged.mbsy[k] = merged.mbsz[k] = merged.broken[k] = 0;
     ++k;
   }
   s.bonds = std::move(merged);
+  if (stress_free && !picked.empty()) s.rest_overlaps = true;
   detail::refresh_bond_topology(s);
   touch(s);  // bonded pairs leave the contact list
   return picked.size();

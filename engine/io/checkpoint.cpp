@@ -21,7 +21,8 @@ namespace asperity {
 namespace {
 
 using detail::State;
-constexpr int kCheckpointVersion = 2;  // 2: servo integral and integral time, group damping
+constexpr int kCheckpointVersion = 3;  // 2: servo integral and integral time, group damping;
+                                       // 3: rest overlaps (stress-free bonds)
 
 template <class T>
 hid_t native_type() {
@@ -200,6 +201,9 @@ void visit(Io& io, State& s) {
                              {"fsx", &q->fsx}, {"fsy", &q->fsy}, {"fsz", &q->fsz},
                              {"fn", &q->fn}, {"overlap", &q->overlap}})
       io.column(at + "/" + name, *col);
+    // Rest overlaps (stress-free bonds) since version 3; older files had none: all 0.
+    if (io.version >= 3) io.column(at + "/rest", q->rest);
+    else q->rest.assign(q->padded, 0.0);
     q->size_outputs();
   }
 
@@ -216,6 +220,12 @@ void visit(Io& io, State& s) {
                            {"mbn", &b.mbn}, {"mbsx", &b.mbsx}, {"mbsy", &b.mbsy},
                            {"mbsz", &b.mbsz}, {"broken", &b.broken}})
     io.column(std::string("bonds/") + name, *col);
+  if (io.version >= 3) {
+    io.column("bonds/rest", b.rest);
+    io.flag("bonds/rest_overlaps", s.rest_overlaps);
+  } else {
+    b.rest.assign(b.padded, 0.0);
+  }
   b.size_outputs();
   io.scalar("bonds/material/beam_kn", b.material.beam_kn);
   io.scalar("bonds/material/beam_ks", b.material.beam_ks);

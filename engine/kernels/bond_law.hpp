@@ -42,13 +42,15 @@ struct BondState {
   T mbn, mbsx, mbsy, mbsz;
 };
 
-// Returns the criterion value (>= 1: broken); sigma and tau are returned too.
+// Returns the criterion value (>= 1: broken); sigma and tau are returned too. U0: the contact
+// bond's rest overlap.
 template <class T>
 inline T bond_forces(const T& nx, const T& ny, const T& nz, const T& U, const T& la, const T& lb,
                      const T& rb, const T& vax, const T& vay, const T& vaz, const T& wax,
                      const T& way, const T& waz, const T& vbx, const T& vby, const T& vbz,
                      const T& wbx, const T& wby, const T& wbz, const T& ox, const T& oy,
-                     const T& oz, BondState<T>& s, T& sigma, T& tau, const BondParams<T>& p) {
+                     const T& oz, const T& U0, BondState<T>& s, T& sigma, T& tau,
+                     const BondParams<T>& p) {
   // Relative velocity at the contact point [3-17, 3-18], as in contact_forces.
   const T vx = (vbx - vax) - lb * (wby * nz - wbz * ny) - la * (way * nz - waz * ny);
   const T vy = (vby - vay) - lb * (wbz * nx - wbx * nz) - la * (waz * nx - wax * nz);
@@ -61,8 +63,9 @@ inline T bond_forces(const T& nx, const T& ny, const T& nz, const T& U, const T&
   carry_shear(ox, oy, oz, nx, ny, nz, phi, s.fbsx, s.fbsy, s.fbsz);
   carry_shear(ox, oy, oz, nx, ny, nz, phi, s.mbsx, s.mbsy, s.mbsz);
 
-  // Contact bond: springs in tension too, no slip.
-  s.fn = p.kn * U;
+  // Contact bond: springs in tension too, no slip; unloaded at the rest overlap U0 (0 unless the
+  // bond was installed stress-free).
+  s.fn = p.kn * (U - U0);
   s.fsx = s.fsx - p.ks * vsx * p.dt;
   s.fsy = s.fsy - p.ks * vsy * p.dt;
   s.fsz = s.fsz - p.ks * vsz * p.dt;

@@ -37,9 +37,10 @@ double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
     // Padding bonds have Rb = 0; give them a harmless radius so no lane divides by zero.
     const auto real = rbeam > T(0.0);
     const T rsafe = select(real, rbeam, T(1.0));
+    const T u0 = k.rest ? Lanes::load(k.rest + i) : T(0.0);
     T sigma, tau;
     const T crit = bond_forces(nx, ny, nz, U, la, lb, rsafe, vax, vay, vaz, wax, way, waz, vbx, vby,
-                               vbz, wbx, wby, wbz, ox, oy, oz, s, sigma, tau, p);
+                               vbz, wbx, wby, wbz, ox, oy, oz, u0, s, sigma, tau, p);
     T brk(0.0);
     if (breakable) {
       brk = select(real & (crit >= T(1.0)), T(1.0), T(0.0));

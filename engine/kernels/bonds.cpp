@@ -22,7 +22,8 @@ kernels::BondKernelArgs bond_kernel_args(State& s) {
           q.fbsy.data(), q.fbsz.data(), q.mbn.data(), q.mbsx.data(), q.mbsy.data(),
           q.mbsz.data(), q.broken.data(), q.fx.data(), q.fy.data(), q.fz.data(), q.cx.data(),
           q.cy.data(), q.cz.data(), q.mx.data(), q.my.data(), q.mz.data(), m.kn, m.ks,
-          bm.beam_kn, bm.beam_ks, s.dt, bm.breakable ? bm.tensile_strength : 0.0, p.capacity};
+          bm.beam_kn, bm.beam_ks, s.dt, bm.breakable ? bm.tensile_strength : 0.0, p.capacity,
+          s.rest_overlaps ? q.rest.data() : nullptr};
 }
 
 struct BondEnergy {
@@ -44,8 +45,8 @@ BondEnergy bond_energy(const State& s, std::size_t k) {
             mbs2 / (2 * bm.beam_kn * 0.25 * r2);
   e.contact_kept = 0;
   e.capped_fs_scale = 0;
-  if (q.overlap[k] > 0) {  // stays a contact: Fn = kn U, Fs capped at mu Fn
-    const double fn = q.fn[k], limit = m.friction * fn, fs = std::sqrt(fs2);
+  if (q.overlap[k] > 0) {  // stays a contact: Fn = kn (U - rest) >= 0, Fs capped at mu Fn
+    const double fn = std::max(q.fn[k], 0.0), limit = m.friction * fn, fs = std::sqrt(fs2);
     e.capped_fs_scale = fs > limit ? limit / fs : 1.0;
     e.contact_kept = fn * fn / (2 * m.kn) + fs2 * e.capped_fs_scale * e.capped_fs_scale / (2 * m.ks);
   }
@@ -169,9 +170,7 @@ void process_breaks(State& s) {
   grown.resize(before + inherit.size());
   for (std::size_t k = 0; k < before; ++k) {
     grown.a[k] = inh.a[k]; grown.b[k] = inh.b[k];
-    grown.nx[k] = inh.nx[k]; grown.ny[k] = inh.ny[k]; grown.nz[k] = inh.nz[k];
-    grown.fsx[k] = inh.fsx[k]; grown.fsy[k] = inh.fsy[k]; grown.fsz[k] = inh.fsz[k];
-    grown.fn[k] = inh.fn[k]; grown.overlap[k] = inh.overlap[k];
+    grown.copy_history(inh, k, k);
   }
   for (std::size_t j = 0; j < inherit.size(); ++j) {
     const std::size_t k = inherit[j], t = before + j;
@@ -179,7 +178,11 @@ void process_breaks(State& s) {
     grown.a[t] = q.a[k]; grown.b[t] = q.b[k];
     grown.nx[t] = q.nx[k]; grown.ny[t] = q.ny[k]; grown.nz[t] = q.nz[k];
     grown.fsx[t] = q.fsx[k] * scale; grown.fsy[t] = q.fsy[k] * scale; grown.fsz[t] = q.fsz[k] * scale;
-    grown.fn[t] = q.fn[k]; grown.overlap[t] = q.overlap[k];
+    grown.fn[t] = std::max(q.fn[k], 0.0);  // a contact bond held in tension leaves no force
+    grown.overlap[t] = q.overlap[k];
+    // A stress-free bond's contact stays unloaded at its rest overlap; a gap bond's (rest < 0)
+    // becomes an ordinary contact, which never pulls.
+    grown.rest[t] = std::max(q.rest[k], 0.0);
   }
   inh = std::move(grown);
   kept.n = n;

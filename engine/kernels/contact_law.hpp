@@ -53,15 +53,18 @@ inline void carry_shear(const T& ox, const T& oy, const T& oz, const T& nx, cons
 }
 
 // Forces of one contact whose geometry is known: normal n (from a to b), overlap U, lever arms
-// la = |xc - xa|, lb = |xc - xb| (xc - xa = la n, xc - xb = -lb n). On entry (o, F) hold the
-// normal and shear force of the previous step; on exit F is the new shear force on b and fn the
-// normal force on b. Returns the energy dissipated by slip in this step.
+// la = |xc - xa|, lb = |xc - xb| (xc - xa = la n, xc - xb = -lb n), rest overlap U0 (the
+// overlap of the unloaded spring: 0 in model.md 4; > 0 for a contact left by a bond installed
+// stress-free). On entry (o, F) hold the normal and shear force of the previous step; on exit F
+// is the new shear force on b and fn the normal force on b. Returns the energy dissipated by slip
+// in this step.
 template <class T>
 inline T contact_forces(const T& nx, const T& ny, const T& nz, const T& U, const T& la,
                         const T& lb, const T& vax, const T& vay, const T& vaz, const T& wax,
                         const T& way, const T& waz, const T& vbx, const T& vby, const T& vbz,
                         const T& wbx, const T& wby, const T& wbz, const T& ox, const T& oy,
-                        const T& oz, T& fx, T& fy, T& fz, T& fn, const LawParams<T>& p) {
+                        const T& oz, const T& U0, T& fx, T& fy, T& fz, T& fn,
+                        const LawParams<T>& p) {
   const auto touching = U > T(0.0);
   // Relative velocity of b with respect to a at the contact point [3-17, 3-18]:
   // V = (vB + wB x (xc - xB)) - (vA + wA x (xc - xA)) = vB - vA - lb (wB x n) - la (wA x n).
@@ -77,8 +80,9 @@ inline T contact_forces(const T& nx, const T& ny, const T& nz, const T& U, const
   fx = fx - p.ks * vsx * p.dt;
   fy = fy - p.ks * vsy * p.dt;
   fz = fz - p.ks * vsz * p.dt;
-  // Normal force [3-12], no tension.
-  fn = select(touching, p.kn * U, T(0.0));
+  // Normal force [3-12], no tension. With U0 = 0 this is kn U wherever U > 0, bit for bit; a
+  // touching pair with 0 < U <= U0 carries no force (and so, by the slip cap, no shear force).
+  fn = select(U > U0, p.kn * (U - U0), T(0.0));
   // Coulomb slip [3-22]: cap |Fs| at mu Fn; the energy dissipated is |Fs_cap| (|Fs_trial| -
   // |Fs_cap|) / ks (model.md 8).
   const T limit = p.friction * fn;

@@ -23,6 +23,9 @@ struct PairKernelArgs {
   // window [a0, a0 + lanes) that fits in the columns loads them with one contiguous load and a
   // lane permutation instead of a gather (lists sorted by a make this the common case); 0 never.
   std::size_t columns = 0;
+  // Rest overlaps (store/pairs.hpp), read and, where the pair no longer touches, reset to 0;
+  // null: every rest overlap is 0 and the column is not touched.
+  double* rest = nullptr;
 };
 
 using PairKernel = double (*)(const PairKernelArgs&, std::size_t begin, std::size_t end);
@@ -46,6 +49,7 @@ struct BondKernelArgs {
   double* mx; double* my; double* mz;
   double kn, ks, beam_kn, beam_ks, dt, strength;
   std::size_t columns = 0;  // as PairKernelArgs::columns
+  const double* rest = nullptr;  // rest overlaps of the contact bonds; null: all 0
 };
 
 using BondKernel = double (*)(const BondKernelArgs&, std::size_t begin, std::size_t end);

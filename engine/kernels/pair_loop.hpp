@@ -33,9 +33,12 @@ double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
     }
     const T ox = Lanes::load(k.nx + i), oy = Lanes::load(k.ny + i), oz = Lanes::load(k.nz + i);
     T fx = Lanes::load(k.fsx + i), fy = Lanes::load(k.fsy + i), fz = Lanes::load(k.fsz + i);
+    const T u0 = k.rest ? Lanes::load(k.rest + i) : T(0.0);
     T fn;
     slip_sum = slip_sum + contact_forces(nx, ny, nz, U, la, lb, vax, vay, vaz, wax, way, waz, vbx,
-                                         vby, vbz, wbx, wby, wbz, ox, oy, oz, fx, fy, fz, fn, p);
+                                         vby, vbz, wbx, wby, wbz, ox, oy, oz, u0, fx, fy, fz, fn, p);
+    // A pair that no longer touches forgets its rest overlap with its shear force.
+    if (k.rest) Lanes::store(k.rest + i, select(U > T(0.0), u0, T(0.0)));
     Lanes::store(k.nx + i, nx); Lanes::store(k.ny + i, ny); Lanes::store(k.nz + i, nz);
     Lanes::store(k.fsx + i, fx); Lanes::store(k.fsy + i, fy); Lanes::store(k.fsz + i, fz);
     Lanes::store(k.fn + i, fn);

@@ -11,7 +11,8 @@ kernels::PairKernelArgs pair_kernel_args(State& s) {
           p.wx.data(), p.wy.data(), p.wz.data(), p.radius.data(), q.a.data(), q.b.data(),
           q.nx.data(), q.ny.data(), q.nz.data(), q.fsx.data(), q.fsy.data(), q.fsz.data(),
           q.fn.data(), q.overlap.data(), q.fx.data(), q.fy.data(), q.fz.data(), q.cx.data(),
-          q.cy.data(), q.cz.data(), m.kn, m.ks, m.friction, s.dt, p.capacity};
+          q.cy.data(), q.cz.data(), m.kn, m.ks, m.friction, s.dt, p.capacity,
+          s.rest_overlaps ? q.rest.data() : nullptr};
 }
 
 void compute_pair_forces(State& s) {

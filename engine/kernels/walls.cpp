@@ -214,7 +214,7 @@ void compute_wall_forces(State& s) {
       slip[blk] += kernels::contact_forces(n.x, n.y, n.z, U, 0.0, lb, wall.velocity.x,
                                            wall.velocity.y, wall.velocity.z, 0.0, 0.0, 0.0,
                                            p.vx[i], p.vy[i], p.vz[i], wx, wy, wz, o.x, o.y, o.z,
-                                           fx, fy, fz, fn, law);
+                                           0.0, fx, fy, fz, fn, law);
       wc.nx[k] = n.x; wc.ny[k] = n.y; wc.nz[k] = n.z;
       wc.fsx[k] = fx; wc.fsy[k] = fy; wc.fsz[k] = fz;
       wc.fn[k] = fn;

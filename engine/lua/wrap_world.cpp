@@ -645,6 +645,7 @@ int world_install_bonds(lua_State* L) {
     m.breakable = o.boolean("breakable", true);
     auto st = o.number("tensile_strength");
     double tolerance = o.number("tolerance", -1);
+    const bool stress_free = o.boolean("stress_free", false);
     std::vector<std::int64_t> ids;
     if (o.push("ids") != LUA_TNIL) ids = ids_arg(L, lua_gettop(L), w, ctx.c_str());
     lua_pop(L, 1);
@@ -652,7 +653,7 @@ int world_install_bonds(lua_State* L) {
     if (m.breakable && !st)
       throw Error(ctx + ": give tensile_strength = (Pa), or breakable = false for elastic bonds");
     if (st) m.tensile_strength = *st;
-    lua_pushinteger(L, static_cast<lua_Integer>(w.install_bonds(m, tolerance, ids)));
+    lua_pushinteger(L, static_cast<lua_Integer>(w.install_bonds(m, tolerance, ids, stress_free)));
     return 1;
   });
 }
@@ -1265,10 +1266,12 @@ void open_world(lua_State* L) {
       // bonds
       {"install_bonds", world_install_bonds,
        "world:install_bonds{tensile_strength= | breakable=false [, beam_kn=] [, beam_ks=]\n"
-       "  [, radius_factor=] [, tolerance=] [, ids=]} -> count",
+       "  [, radius_factor=] [, tolerance=] [, ids=] [, stress_free=false]} -> count",
        "Bonds (contact + parallel bond, model.md 5) between every pair closer than tolerance\n"
        "(default 1e-3 mean radius); beam_kn defaults to the world's kn, beam_ks to beam_kn/10;\n"
-       "ids (a list or predicate) restricts them to pairs of those particles."},
+       "ids (a list or predicate) restricts them to pairs of those particles. Existing contact\n"
+       "forces are kept; stress_free = true unloads each contact bond at its current overlap\n"
+       "instead (a contact left by a break keeps that rest overlap until the pair separates)."},
       {"bond_count", world_bond_count, "world:bond_count() -> n", "Intact bonds."},
       {"set_bond_strength", world_set_bond_strength,
        "world:set_bond_strength{tensile_strength= | breakable=false}",

@@ -143,9 +143,7 @@ void reorder(State& s, const CellGrid& g) {
   for (std::size_t k = 0; k < q.n; ++k) {
     const std::size_t o = perm[k];
     sorted.a[k] = q.a[o]; sorted.b[k] = q.b[o];
-    sorted.nx[k] = q.nx[o]; sorted.ny[k] = q.ny[o]; sorted.nz[k] = q.nz[o];
-    sorted.fsx[k] = q.fsx[o]; sorted.fsy[k] = q.fsy[o]; sorted.fsz[k] = q.fsz[o];
-    sorted.fn[k] = q.fn[o]; sorted.overlap[k] = q.overlap[o];
+    sorted.copy_history(q, o, k);
   }
   q = std::move(sorted);
 
@@ -283,9 +281,7 @@ void build_pairs(State& s, const CellGrid& g) {
     const std::int64_t a = fresh.a[k], b = fresh.b[k];
     while (o < old.n && (old.a[o] < a || (old.a[o] == a && old.b[o] < b))) ++o;
     if (o < old.n && old.a[o] == a && old.b[o] == b) {
-      fresh.nx[k] = old.nx[o]; fresh.ny[k] = old.ny[o]; fresh.nz[k] = old.nz[o];
-      fresh.fsx[k] = old.fsx[o]; fresh.fsy[k] = old.fsy[o]; fresh.fsz[k] = old.fsz[o];
-      fresh.fn[k] = old.fn[o];
+      fresh.copy_history(old, o, k);
       // The overlap as it is now (radii may have changed since the last step): the time-step
       // estimate made right after this rebuild counts the contacts of the current geometry.
       const double dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];
@@ -298,7 +294,7 @@ void build_pairs(State& s, const CellGrid& g) {
       fresh.ny[k] = d > 0 ? dy / d : 0.0;
       fresh.nz[k] = d > 0 ? dz / d : 0.0;
       fresh.fsx[k] = fresh.fsy[k] = fresh.fsz[k] = 0;
-      fresh.fn[k] = 0;
+      fresh.fn[k] = fresh.rest[k] = 0;
       fresh.overlap[k] = p.radius[a] + p.radius[b] - d;
     }
   }
@@ -316,10 +312,7 @@ void build_pairs(State& s, const CellGrid& g) {
                           (ih.a[order[j]] == fresh.a[k] && ih.b[order[j]] < fresh.b[k])))
         ++j;
       if (j < ih.n && ih.a[order[j]] == fresh.a[k] && ih.b[order[j]] == fresh.b[k]) {
-        const std::size_t o = order[j];
-        fresh.nx[k] = ih.nx[o]; fresh.ny[k] = ih.ny[o]; fresh.nz[k] = ih.nz[o];
-        fresh.fsx[k] = ih.fsx[o]; fresh.fsy[k] = ih.fsy[o]; fresh.fsz[k] = ih.fsz[o];
-        fresh.fn[k] = ih.fn[o]; fresh.overlap[k] = ih.overlap[o];
+        fresh.copy_history(ih, order[j], k);
       }
     }
     ih.resize(0);

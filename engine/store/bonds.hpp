@@ -23,6 +23,8 @@ struct BondStore {
   AVec<double> fsx, fsy, fsz;             // contact bond shear force (history)
   AVec<double> fn;                        // contact bond normal force kn U (may be < 0)
   AVec<double> overlap;                   // U
+  AVec<double> rest;                      // overlap of the unloaded contact bond (stress-free
+                                          // installation; else 0): fn = kn (U - rest)
   AVec<double> fbn;                       // parallel bond normal force (> 0 compression)
   AVec<double> fbsx, fbsy, fbsz;          // parallel bond shear force
   AVec<double> mbn;                       // twisting moment (along n)
@@ -39,7 +41,7 @@ struct BondStore {
     n = count;
     padded = round_up(count, kMaxLanes);
     for (auto* c : {&a, &b}) c->resize(padded);
-    for (auto* c : {&beam_radius, &nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &overlap, &fbn, &fbsx,
+    for (auto* c : {&beam_radius, &nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &overlap, &rest, &fbn, &fbsx,
                     &fbsy, &fbsz, &mbn, &mbsx, &mbsy, &mbsz, &broken})
       c->resize(padded);
     size_outputs();
@@ -54,7 +56,7 @@ struct BondStore {
       b[i] = null_b;
       beam_radius[i] = 0;
       nx[i] = 1;
-      ny[i] = nz[i] = fsx[i] = fsy[i] = fsz[i] = fn[i] = overlap[i] = fbn[i] = 0;
+      ny[i] = nz[i] = fsx[i] = fsy[i] = fsz[i] = fn[i] = overlap[i] = rest[i] = fbn[i] = 0;
       fbsx[i] = fbsy[i] = fbsz[i] = mbn[i] = mbsx[i] = mbsy[i] = mbsz[i] = broken[i] = 0;
       fx[i] = fy[i] = fz[i] = cx[i] = cy[i] = cz[i] = mx[i] = my[i] = mz[i] = 0;
     }
@@ -64,7 +66,7 @@ struct BondStore {
     a[k] = from.a[o]; b[k] = from.b[o]; beam_radius[k] = from.beam_radius[o];
     nx[k] = from.nx[o]; ny[k] = from.ny[o]; nz[k] = from.nz[o];
     fsx[k] = from.fsx[o]; fsy[k] = from.fsy[o]; fsz[k] = from.fsz[o];
-    fn[k] = from.fn[o]; overlap[k] = from.overlap[o]; fbn[k] = from.fbn[o];
+    fn[k] = from.fn[o]; overlap[k] = from.overlap[o]; rest[k] = from.rest[o]; fbn[k] = from.fbn[o];
     fbsx[k] = from.fbsx[o]; fbsy[k] = from.fbsy[o]; fbsz[k] = from.fbsz[o];
     mbn[k] = from.mbn[o]; mbsx[k] = from.mbsx[o]; mbsy[k] = from.mbsy[o]; mbsz[k] = from.mbsz[o];
     broken[k] = from.broken[o];

@@ -22,6 +22,11 @@ struct PairStore {
   AVec<double> fsx, fsy, fsz;  // shear force on b (history)
   AVec<double> fn;             // normal force on b along n (>= 0)
   AVec<double> overlap;        // U = Ra + Rb - d (negative: not touching)
+  // Rest overlap (history): the overlap at which the normal spring is unloaded, Fn = kn (U - rest)
+  // (model.md 4 has rest = 0). Only a contact left behind by a bond installed stress-free has
+  // rest > 0 (World::install_bonds); it is forgotten with the shear force when U <= 0. The pair
+  // kernel reads it only when State::rest_overlaps is set.
+  AVec<double> rest;
   AVec<double> fx, fy, fz;     // force on b: fn n + fs (on a: its negative)
   AVec<double> cx, cy, cz;     // n x fs: the torque on either particle is -(R - U/2) times it
 
@@ -29,7 +34,7 @@ struct PairStore {
     n = count;
     padded = round_up(count, kMaxLanes);
     for (auto* c : {&a, &b}) c->resize(padded);
-    for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &overlap}) c->resize(padded);
+    for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &overlap, &rest}) c->resize(padded);
     size_outputs();
   }
   // The gather's columns are not saved: a store read from a checkpoint sizes them here.
@@ -42,10 +47,16 @@ struct PairStore {
       a[i] = null_a;
       b[i] = null_b;
       nx[i] = 1;
-      ny[i] = nz[i] = fsx[i] = fsy[i] = fsz[i] = fn[i] = 0;
+      ny[i] = nz[i] = fsx[i] = fsy[i] = fsz[i] = fn[i] = rest[i] = 0;
       fx[i] = fy[i] = fz[i] = cx[i] = cy[i] = cz[i] = 0;
       overlap[i] = -1;
     }
+  }
+  // Copy the history of pair o of `from` into slot k of this store.
+  void copy_history(const PairStore& from, std::size_t o, std::size_t k) {
+    nx[k] = from.nx[o]; ny[k] = from.ny[o]; nz[k] = from.nz[o];
+    fsx[k] = from.fsx[o]; fsy[k] = from.fsy[o]; fsz[k] = from.fsz[o];
+    fn[k] = from.fn[o]; overlap[k] = from.overlap[o]; rest[k] = from.rest[o];
   }
 };
 

@@ -253,8 +253,12 @@ class World {
   // the current configuration; existing contact forces are kept. With `ids`, only pairs of two
   // listed particles. Pairs already bonded and members of one rigid group are skipped.
   // Returns the number of bonds installed.
+  // stress_free: instead, each new contact bond is unloaded at its current overlap (its rest
+  // overlap: Fn = kn (U - rest), shear force 0), and a contact it leaves behind when it breaks
+  // keeps that rest overlap until the pair separates. Not model.md 5's rule: it removes the
+  // stresses a jammed packing would lock into the bonds (scripts/README.md, "The REV").
   std::size_t install_bonds(const BondMaterial& material, double tolerance = -1,
-                            std::span<const std::int64_t> ids = {});
+                            std::span<const std::int64_t> ids = {}, bool stress_free = false);
   std::size_t bond_count() const;                   // intact bonds
   // Change the strength of every bond (e.g. unbreakable while a specimen is prepared, then the
   // calibrated strength for the fracture model). Stiffness and stored forces are unchanged.

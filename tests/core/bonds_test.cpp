@@ -250,6 +250,89 @@ TEST(Bonds, InstallingBeforeTheFirstStepKeepsTheSkin) {
   EXPECT_LE(w.stats().rebuilds - before, 2u);
 }
 
+namespace {
+// Two spheres along z overlapping by u0, both free, no damping; bonded (stress-free or keeping the
+// contact force kn u0).
+World overlapping_bonded_pair(double u0, bool stress_free, double strength = 0) {
+  WorldSettings ws;
+  ws.local_damping = 0;
+  ws.dt = 1e-4;
+  World w(ws);
+  w.add_particle({0, 0, 0}, kR);
+  w.add_particle({0, 0, 2 * kR - u0}, kR);
+  BondMaterial bm;
+  bm.breakable = strength > 0;
+  bm.tensile_strength = strength;
+  EXPECT_EQ(w.install_bonds(bm, -1, {}, stress_free), 1u);
+  return w;
+}
+}  // namespace
+
+TEST(Bonds, StressFreeInstallationLeavesAnOverlappingPairAtRest) {
+  const double u0 = 0.02 * kR;
+  World kept = overlapping_bonded_pair(u0, false), free = overlapping_bonded_pair(u0, true);
+  const auto x0 = free.positions();
+  kept.cycle(50);  // 0.44 of the pair's period: b has moved by nearly u0 / 2
+  free.cycle(50);
+  // Kept (model.md 5): the contact bond pushes with kn u0 and the pair oscillates about the
+  // distance where the contact bond's push equals the beam's pull.
+  EXPECT_GT(kept.positions()[5] - x0[5], 0.25 * u0) << "the kept contact force pushes b away";
+  // Stress-free: no force at the installed distance, so nothing moves and nothing is stored.
+  EXPECT_EQ(free.positions(), x0);
+  EXPECT_EQ(free.energies().strain, 0.0);
+  const auto info = free.bonds();
+  ASSERT_EQ(info.size(), 1u);
+  EXPECT_EQ(info[0].normal_force, 0.0);
+}
+
+TEST(Bonds, StressFreeBondResistsFromTheInstalledDistanceAndItsContactKeepsTheRestOverlap) {
+  // b driven along z; a held. The bond is stiff kn + beam_kn about the installed distance; it
+  // breaks in tension at sigma = st, i.e. a stretch delta = st A / beam_kn, while the spheres
+  // still overlap (u0 > delta): the contact left behind is unloaded until b comes back past the
+  // installed overlap, then pushes with kn (U - u0). Once the spheres part it is an ordinary
+  // contact again (Fn = kn U).
+  const double u0 = 0.02 * kR, st = 0.5, kn = 0.1;
+  World w = overlapping_bonded_pair(u0, true, st);
+  GroupMotion fixed;
+  fixed.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
+  w.add_group(std::vector<std::int64_t>{0}, fixed);
+  const double v = 1e-5;
+  const int gb = w.add_group(std::vector<std::int64_t>{1}, moving({0, 0, v}));
+  const double z0 = w.group_position(gb).z;
+  // Stretch from the installed distance where the last step's forces were evaluated: the
+  // position before that step's move (leapfrog).
+  auto stretch = [&] { return w.group_position(gb).z - w.group_velocity(gb).z * w.dt() - z0; };
+  w.cycle(100);
+  EXPECT_NEAR(w.group_force(gb).z, -2 * kn * stretch(), 1e-9 * 2 * kn * stretch())
+      << "contact bond and beam, both from the installed distance";
+  const double delta = st * kArea / kn;
+  ASSERT_LT(delta, u0) << "the test needs the break while the spheres overlap";
+  while (w.bond_count() == 1 && w.step_count() < 1000000) w.cycle(1);
+  ASSERT_EQ(w.break_events().size(), 1u);
+  EXPECT_NEAR(w.break_events()[0].sigma, st, 1e-3 * st);
+  w.cycle(10);
+  ASSERT_EQ(w.contact_count(), 1u) << "the spheres still overlap";
+  EXPECT_EQ(w.group_force(gb).z, 0.0) << "0 < U < u0: the contact is unloaded";
+  // Back: push b in until it is 0.5 u0 past the installed distance.
+  w.set_group_motion(gb, moving({0, 0, -v}));
+  while (stretch() > -0.5 * u0) w.cycle(1);
+  w.cycle(1);
+  const double u_beyond = -stretch();  // U - u0 at the last force evaluation
+  ASSERT_GT(u_beyond, 0.0);
+  EXPECT_NEAR(w.group_force(gb).z, kn * u_beyond, 1e-6 * kn * u_beyond) << "Fn = kn (U - u0)";
+  // Apart: pull b until the spheres no longer touch, then back into a small overlap.
+  w.set_group_motion(gb, moving({0, 0, 20 * v}));
+  while (stretch() < u0 + 0.01 * kR) w.cycle(1);
+  w.cycle(5);
+  EXPECT_EQ(w.contact_count(), 0u);
+  w.set_group_motion(gb, moving({0, 0, -20 * v}));
+  while (stretch() > u0 - 0.005 * kR) w.cycle(1);
+  w.cycle(1);
+  const double U = u0 - stretch();
+  ASSERT_GT(U, 0.0);
+  EXPECT_NEAR(w.group_force(gb).z, kn * U, 1e-6 * kn * U) << "forgotten: Fn = kn U again";
+}
+
 // Param: the shared layout of test::kernel_test_pair (else separate).
 class SimdBondKernel : public ::testing::TestWithParam<bool> {};
 
@@ -261,7 +344,7 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
   AVec<double> x(n), y(n), z(n), vx(n), vy(n), vz(n), wx(n), wy(n), wz(n), r(n);
   AVec<std::int64_t> a(bonds), b(bonds);
   AVec<double> rb(bonds);
-  std::vector<AVec<double>> hist(27, AVec<double>(bonds));  // 18..26: outputs for the gather
+  std::vector<AVec<double>> hist(28, AVec<double>(bonds));  // 18..26: outputs for the gather, 27 rest
   for (std::size_t i = 0; i < n; ++i) {
     r[i] = kR * (1 + 0.3 * u(rng));
     vx[i] = 1e-3 * u(rng); vy[i] = 1e-3 * u(rng); vz[i] = 1e-3 * u(rng);
@@ -280,8 +363,9 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
     // Forces ~1e-6 N and moments ~1e-10 N m give stresses ~1 Pa, around the strength of 1 Pa.
     for (int c = 3; c < 12; ++c) hist[c][k] = 1e-6 * u(rng);
     for (int c = 12; c < 16; ++c) hist[c][k] = 1e-10 * u(rng);
+    hist[27][k] = (k % 3 == 0) ? 0.01 * r[ia] * u(rng) : 0.0;  // rest overlaps, stress-free bonds
   }
-  auto run = [&](const kernels::KernelSet& ks, std::vector<AVec<double>> h) {
+  auto run = [&](const kernels::KernelSet& ks, std::vector<AVec<double>> h, bool rest) {
     kernels::BondKernelArgs args{x.data(), y.data(), z.data(), vx.data(), vy.data(), vz.data(),
                                  wx.data(), wy.data(), wz.data(), r.data(), a.data(), b.data(),
                                  rb.data(), h[0].data(), h[1].data(), h[2].data(), h[3].data(),
@@ -290,19 +374,27 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
                                  h[13].data(), h[14].data(), h[15].data(), h[17].data(),
                                  h[18].data(), h[19].data(), h[20].data(), h[21].data(),
                                  h[22].data(), h[23].data(), h[24].data(), h[25].data(),
-                                 h[26].data(), 0.1, 0.01, 0.1, 0.01, 1e-3, 1.0, n};
+                                 h[26].data(), 0.1, 0.01, 0.1, 0.01, 1e-3, 1.0, n,
+                                 rest ? h[27].data() : nullptr};
     const double broken = ks.bond(args, 0, bonds);
     return std::make_pair(broken, h);
   };
-  const auto ref = run(kernels::scalar_kernels(), hist);
-  ASSERT_GT(ref.first, 0.0) << "some random bonds must break";
-  ASSERT_LT(ref.first, double(bonds)) << "and some must hold";
-  for (const auto& arch : available_simd_architectures()) {
-    const auto got = run(kernels::select_kernels(arch), hist);
-    EXPECT_EQ(got.first, ref.first) << arch;
-    for (int c = 0; c < 27; ++c)
-      EXPECT_EQ(0, std::memcmp(got.second[c].data(), ref.second[c].data(), bonds * sizeof(double)))
-          << arch << " column " << c;
+  for (bool rest : {false, true}) {
+    const auto ref = run(kernels::scalar_kernels(), hist, rest);
+    ASSERT_GT(ref.first, 0.0) << "some random bonds must break";
+    ASSERT_LT(ref.first, double(bonds)) << "and some must hold";
+    if (rest) {
+      const auto without = run(kernels::scalar_kernels(), hist, false);
+      EXPECT_NE(0, std::memcmp(without.second[6].data(), ref.second[6].data(), bonds * sizeof(double)))
+          << "the rest overlaps change the contact bond's normal force";
+    }
+    for (const auto& arch : available_simd_architectures()) {
+      const auto got = run(kernels::select_kernels(arch), hist, rest);
+      EXPECT_EQ(got.first, ref.first) << arch;
+      for (int c = 0; c < 28; ++c)
+        EXPECT_EQ(0, std::memcmp(got.second[c].data(), ref.second[c].data(), bonds * sizeof(double)))
+            << arch << " column " << c << (rest ? " rest" : "");
+    }
   }
 }
 INSTANTIATE_TEST_SUITE_P(Bonds, SimdBondKernel, ::testing::Values(false, true),

@@ -49,7 +49,8 @@ namespace {
 struct RandomPairs {
   std::vector<double, AlignedAllocator<double>> x, y, z, vx, vy, vz, wx, wy, wz, r;
   std::vector<std::int64_t, AlignedAllocator<std::int64_t>> a, b;
-  std::vector<double, AlignedAllocator<double>> nx, ny, nz, fsx, fsy, fsz, fn, U, fx, fy, fz, cx, cy, cz;
+  std::vector<double, AlignedAllocator<double>> nx, ny, nz, fsx, fsy, fsz, fn, U, fx, fy, fz, cx, cy, cz,
+      rest;
   RandomPairs(std::size_t pairs, unsigned seed, bool shared = false) {
     const std::size_t n = shared ? test::a_particles(pairs) + pairs : 2 * pairs;
     std::mt19937_64 rng(seed);
@@ -62,7 +63,7 @@ struct RandomPairs {
       x[i] = u(rng); y[i] = u(rng); z[i] = u(rng);
     }
     a.resize(pairs); b.resize(pairs);
-    for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &U, &fx, &fy, &fz, &cx, &cy, &cz})
+    for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &U, &fx, &fy, &fz, &cx, &cy, &cz, &rest})
       c->resize(pairs);
     for (std::size_t k = 0; k < pairs; ++k) {
       std::tie(a[k], b[k]) = test::kernel_test_pair(k, pairs, shared);
@@ -76,14 +77,18 @@ struct RandomPairs {
       nx[k] = old.x; ny[k] = old.y; nz[k] = old.z;
       const double s = (k % 5 == 0) ? 0.0 : 1e-5;
       fsx[k] = s * u(rng); fsy[k] = s * u(rng); fsz[k] = s * u(rng);
+      // Rest overlaps (stress-free bonds' contacts) on every third pair, around the overlaps.
+      rest[k] = (k % 3 == 0) ? 0.05 * r[ia] * (1 + u(rng)) : 0.0;
     }
   }
   kernels::PairKernelArgs args() {
     return {x.data(), y.data(), z.data(), vx.data(), vy.data(), vz.data(), wx.data(), wy.data(),
             wz.data(), r.data(), a.data(), b.data(), nx.data(), ny.data(), nz.data(), fsx.data(),
             fsy.data(), fsz.data(), fn.data(), U.data(), fx.data(), fy.data(), fz.data(),
-            cx.data(), cy.data(), cz.data(), 0.1, 0.01, 0.5, 1e-3, x.size()};
+            cx.data(), cy.data(), cz.data(), 0.1, 0.01, 0.5, 1e-3, x.size(),
+            with_rest ? rest.data() : nullptr};
   }
+  bool with_rest = false;
 };
 }  // namespace
 
@@ -94,15 +99,18 @@ TEST(Determinism, SimdKernelsEqualTheScalarReferenceBitwise) {
   for (const auto& arch : archs) {
     const auto& simd = kernels::select_kernels(arch);
     for (bool shared : {false, true})
+    for (bool rest : {false, true})
     for (bool rotation : {true, false}) {
       RandomPairs ref(pairs, 11, shared), got(pairs, 11, shared);
+      ref.with_rest = got.with_rest = rest;
       const auto& sk = kernels::scalar_kernels();
       const double slip_ref = (rotation ? sk.pair : sk.pair_norot)(ref.args(), 0, pairs);
       const double slip_got = (rotation ? simd.pair : simd.pair_norot)(got.args(), 0, pairs);
       auto same = [&](const auto& u, const auto& v) {
         return std::memcmp(u.data(), v.data(), pairs * sizeof(double)) == 0;
       };
-      const std::string what = arch + (shared ? " shared a" : " separate");
+      const std::string what = arch + (shared ? " shared a" : " separate") + (rest ? " rest" : "");
+      EXPECT_TRUE(same(ref.rest, got.rest)) << what;
       EXPECT_TRUE(same(ref.fn, got.fn)) << what;
       EXPECT_TRUE(same(ref.U, got.U)) << what;
       EXPECT_TRUE(same(ref.nx, got.nx) && same(ref.ny, got.ny) && same(ref.nz, got.nz)) << what;
