@@ -810,7 +810,8 @@ double World::unbalanced_force_ratio() const {
   for (std::size_t k = 0; k < s.walls.contacts.n; ++k)
     if (s.walls.contacts.overlap[k] > 0) { contact += s.walls.contacts.fn[k]; ++contacts; }
   if (bodies == 0) return 0;
-  if (contacts == 0 || contact == 0) return std::numeric_limits<double>::infinity();
+  // Nothing pushes and nothing is unbalanced (a specimen bonded stress-free): at rest.
+  if (contacts == 0 || contact == 0) return unbalanced == 0 ? 0.0 : std::numeric_limits<double>::infinity();
   return (unbalanced / double(bodies)) / (contact / double(contacts));
 }
 

@@ -17,18 +17,24 @@
 local mat = require("materials")
 local P = require("params").defaults{
   target_mpa = mat.rock.tensile_strength / 1e6,
-  start = mat.rev.bond_tensile_strength,   -- Pa, first trial st
+  start = 0,                              -- Pa, first trial st (0: the calibrated one of materials.lua)
   tolerance = 0.01,                       -- relative, on the scaled tensile strength
   iterations = 8,
   seed = 1,
   compression = false,
+  packing_stress = -1,                    -- Pa, passed to rev.lua (0: bond as packed; < 0: materials.lua's)
+  stress_free_bonds = false,              -- passed to rev.lua
   out = "out/calibration",
 }
+local rev_material = mat.rev_for(P.stress_free_bonds)
+if P.start <= 0 then P.start = rev_material.bond_tensile_strength end
+if P.packing_stress < 0 then P.packing_stress = rev_material.packing_stress end
 local out = asperity.mkdir(P.out)
 local rev_script = asperity.scripts_dir .. "/rev.lua"
 
 local function rev(st, tests, k)
-  params = {tensile_strength = st, tests = tests, seed = P.seed, out = ("%s/trial_%02d"):format(out, k)}
+  params = {tensile_strength = st, tests = tests, seed = P.seed, packing_stress = P.packing_stress,
+            stress_free_bonds = P.stress_free_bonds, out = ("%s/trial_%02d"):format(out, k)}
   return dofile(rev_script)
 end
 

@@ -289,7 +289,8 @@ class World {
 
   // --- measurements ----------------------------------------------------------------------
   Energies energies() const;              // kinetic and strain computed now; ledgers cumulative
-  // PFC's equilibrium ratio: mean |unbalanced force| over particles / mean contact normal force.
+  // PFC's equilibrium ratio: mean |unbalanced force| over particles / mean contact normal force
+  // (unbonded contacts); 0 when no force acts at all, infinite when forces act but no contact pushes.
   double unbalanced_force_ratio() const;
   std::vector<ContactInfo> contacts() const;  // touching ball-ball pairs
   std::size_t contact_count() const;

@@ -30,7 +30,27 @@ M.rev = {
   young_modulus = 36.08,          -- Pa, E_REV (model units); the source's REV had 49 Pa
   bond_tensile_strength = 0.020623, -- Pa, st of the elliptic criterion
   packing_stress = 0.005,         -- Pa, wall stress asked of the stress installation before bonding
+  stress_free_bonds = false,      -- model.md 5: bonds keep the existing contact forces
 }
+
+-- The same REV bonded as packed (no stress installation) with stress-free bonds
+-- (world:install_bonds{stress_free = true}: the packing's 0.20 Pa wall stress is not locked into
+-- the bonds), from
+--   build/asperity run scripts/calibrate_rev.lua packing_stress=0 stress_free_bonds=true compression=true start=0.0222
+-- (2026-11-25, 1 trial): E_REV 48.83 Pa (the source's REV: 49 Pa), nu 0.226, REV tensile strength
+-- 0.01045 Pa = 6.60 MPa scaled (source: 0.0111 Pa), compressive 0.1988 Pa = 125.6 MPa, sc/st 19.
+-- The joint scenario uses it with stress_free_bonds=true (its halves are bonded as packed too).
+M.rev_stress_free = {
+  young_modulus = 48.832,
+  bond_tensile_strength = 0.0222,
+  packing_stress = 0,
+  stress_free_bonds = true,
+}
+
+-- The REV material that matches a preparation: stress-free bonds or model.md 5's.
+function M.rev_for(stress_free_bonds)
+  return stress_free_bonds and M.rev_stress_free or M.rev
+end
 
 -- Bond material for world:install_bonds: beams as stiff as the contact springs (kbn A = kn,
 -- kbs A = ks), lambda = 1, the calibrated strength; `over` replaces fields.
