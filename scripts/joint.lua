@@ -16,7 +16,8 @@
 -- Models [scenarios.md 4]: rigid (each half one rigid body; only particles that can touch the
 -- other half are searched), elastic (unbreakable bonds), fracture (elliptic criterion with the
 -- calibrated bond strength; refused while the prepared halves lock more stress into their bonds
--- than that strength, see scripts/README.md). Stresses are reported in model units and scaled to
+-- than that strength, see scripts/README.md; stress_free_bonds=true installs the bonds unloaded,
+-- with the REV material calibrated that way). Stresses are reported in model units and scaled to
 -- rock [3-37].
 --
 -- Writes into `out`: summary.json; closure.{h5,csv}, shear.{h5,csv}; snapshots (HDF5 + XDMF) at
