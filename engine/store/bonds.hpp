@@ -21,7 +21,7 @@ struct BondStore {
   AVec<double> beam_radius;               // Rb
   AVec<double> nx, ny, nz;                // normal of the last step
   AVec<double> fsx, fsy, fsz;             // contact bond shear force (history)
-  AVec<double> fn;                        // contact bond normal force kn U (may be < 0)
+  AVec<double> fn;                        // contact bond normal force kn (U - rest) (may be < 0)
   AVec<double> overlap;                   // U
   AVec<double> rest;                      // overlap of the unloaded contact bond (stress-free
                                           // installation; else 0): fn = kn (U - rest)

@@ -40,7 +40,9 @@ void restart_continues_bit_for_bit(bool stress_free_bonds) {
   m.servo[2].target_force = 1e-6;
   w.add_group(top, m);
   w.cycle(500);
-  const std::string path = temp_file("asperity_checkpoint_test.h5");
+  // One file per test: ctest -j runs the two variants at once.
+  const std::string path = temp_file(stress_free_bonds ? "asperity_checkpoint_test_stress_free.h5"
+                                                       : "asperity_checkpoint_test.h5");
   w.save(path);
   w.cycle(700);
 
