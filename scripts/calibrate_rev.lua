@@ -76,6 +76,7 @@ if P.compression then
 end
 asperity.write_json(out .. "/summary.json", {parameters = P, trials = trials, result = result})
 print(("calibrated: bond_tensile_strength = %.5g Pa (E_REV = %.5g Pa, REV tensile strength %.3f MPa " ..
-       "scaled) after %d trials; put it in scripts/lib/materials.lua (M.rev)")
-      :format(result.bond_tensile_strength_pa, result.young_modulus_pa, result.tensile_strength_mpa, #trials))
+       "scaled) after %d trials; put it in scripts/lib/materials.lua (%s)")
+      :format(result.bond_tensile_strength_pa, result.young_modulus_pa, result.tensile_strength_mpa, #trials,
+              P.stress_free_bonds and "M.rev_stress_free" or "M.rev"))
 return result

@@ -58,7 +58,7 @@ local P = require("params").defaults{
   lock_rotation = true,      -- model.md 2: bonded particles do not rotate
   bond_gap = 0,              -- m, largest gap bonded (0: the engine's default, 1e-3 x mean radius)
   stress_free_bonds = rev.stress_free_bonds, -- true: each contact bond unloaded at its installed overlap (not model.md 5's
-                             -- "existing contact forces are kept"; scripts/README.md, "The REV")
+                             -- "existing contact forces are kept"; scripts/README.md, "Stress-free bonds")
   dt_safety = 0,             -- time step / critical estimate in the tests (0: the engine's 0.8)
   threads = 1,
   out = "out/rev",
