@@ -643,8 +643,9 @@ std::size_t World::install_bonds(const BondMaterial& material, double tolerance,
     merged.nx[k] = dx / d; merged.ny[k] = dy / d; merged.nz[k] = dz / d;
     // An existing contact's forces are kept by the contact bond (model.md 5); stress-free, the
     // contact bond is unloaded at the current overlap instead. The beam starts unloaded.
-    const double keep = stress_free ? 0.0 : 1.0;
-    merged.fsx[k] = keep * q.fsx[c]; merged.fsy[k] = keep * q.fsy[c]; merged.fsz[k] = keep * q.fsz[c];
+    merged.fsx[k] = stress_free ? 0.0 : q.fsx[c];
+    merged.fsy[k] = stress_free ? 0.0 : q.fsy[c];
+    merged.fsz[k] = stress_free ? 0.0 : q.fsz[c];
     merged.overlap[k] = p.radius[a] + p.radius[b] - d;
     merged.rest[k] = stress_free ? merged.overlap[k] : 0.0;
     merged.fn[k] = s.settings.contact.kn * (merged.overlap[k] - merged.rest[k]);
