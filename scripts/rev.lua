@@ -37,8 +37,7 @@ local figures = require("figures")
 
 -- The calibrated material of the chosen bond installation (scripts/lib/materials.lua) supplies
 -- the defaults of st and the packing stress.
-local asked = params and params.stress_free_bonds
-local rev = mat.rev_for(asked == true or asked == "true")
+local rev = mat.rev_for(params ~= nil and params.stress_free_bonds == true)
 local P = require("params").defaults{
   size = 0.01, porosity = mat.packing.porosity, seed = 1,
   mean_radius = mat.packing.mean_radius, radius_sd = mat.packing.radius_sd,
