@@ -130,6 +130,7 @@ void compute_pair_forces(State& s);     // kernels/pairs.cpp
 kernels::PairKernelArgs pair_kernel_args(State& s);  // its kernel's arguments (perf/ reuses them)
 void compute_wall_forces(State& s);     // kernels/walls.cpp
 void compute_bond_forces(State& s);     // kernels/bonds.cpp
+kernels::BondKernelArgs bond_kernel_args(State& s);  // its kernel's arguments (perf/ reuses them)
 void process_breaks(State& s);          // kernels/bonds.cpp: events, energy, compaction
 void refresh_bond_topology(State& s);   // kernels/bonds.cpp: incidence, partners, rotation locks
 // CSR of the pairs (a, b) per particle, entries (k << 1) | (particle is b), ascending k.

@@ -4,6 +4,10 @@
 //   neighbors/N:<n>/threads:<t>          World::rebuild_neighbors (no reorder; history carried)
 //   pair/<simd>/N:<n>/threads:<t>        the pair kernel of each SIMD architecture the CPU has,
 //                                        over the whole pair list in the engine's blocks
+//   bond/<simd>/N:<n>/threads:<t>        the bond kernel likewise, on the lattice with every
+//                                        touching pair bonded (as `perf/lattice.lua bonded=true`:
+//                                        unbreakable, beam stiffnesses kn and kn 2/7, rotation
+//                                        locked by the bonds as model.md 5 says)
 //   walls/N:<n>/threads:<t>              the ball-wall kernel (six planes)
 //   gather_integrate/N:<n>/threads:<t>   the fused gather + leapfrog stage
 //   step/N:<n>/threads:<t>               World::cycle(1): one whole step
@@ -50,6 +54,14 @@ struct SceneCache {
       o.threads = 1;
       o.reorder_interval = 0;  // stages are timed on the creation order; see perf/README.md
       world = std::make_unique<World>(asperity::perf::make_lattice(o));
+      if (k == "bond") {
+        world->cycle(1);  // the neighbour list the bonds are installed from
+        asperity::BondMaterial bm;
+        bm.beam_kn = 0.1;
+        bm.beam_ks = 0.1 * 2.0 / 7.0;
+        bm.breakable = false;
+        world->install_bonds(bm);
+      }
       world->cycle(2);  // neighbour list, wall contacts, history, dt estimate in place
       n = edge;
       kind = k;
@@ -93,6 +105,31 @@ void bm_pair(benchmark::State& st, int edge, int threads, std::string simd) {
     benchmark::ClobberMemory();
   }
   set_counters(st, w.particle_count(), s.pairs.n);
+  st.SetLabel(ks.name);
+}
+
+// The bond stage as engine/kernels/bonds.cpp runs it, with the kernel set of a given name.
+void bm_bond(benchmark::State& st, int edge, int threads, std::string simd) {
+  World& w = cache.get(edge, "bond");
+  State& s = w.state();
+  const auto& ks = asperity::kernels::select_kernels(simd);
+  const auto kernel = s.any_rotating ? ks.bond : ks.bond_norot;
+  const asperity::kernels::BondKernelArgs k = bond_kernel_args(s);
+  const std::size_t total = s.bonds.padded;
+  const std::size_t blocks = (total + kPairBlock - 1) / kPairBlock;
+  std::vector<double> breaks(blocks);
+  for (auto _ : st) {
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (std::size_t blk = 0; blk < blocks; ++blk) {
+      const std::size_t begin = blk * kPairBlock;
+      breaks[blk] = kernel(k, begin, std::min(total, begin + kPairBlock));
+    }
+    benchmark::DoNotOptimize(breaks.data());
+    benchmark::ClobberMemory();
+  }
+  set_counters(st, w.particle_count(), 0);
+  st.counters["bonds"] =
+      benchmark::Counter(double(s.bonds.n) * double(st.iterations()), benchmark::Counter::kIsRate);
   st.SetLabel(ks.name);
 }
 
@@ -176,6 +213,8 @@ void register_all(bool full) {
     reg("neighbors", bm_neighbors);
     for (const auto& a : archs)
       reg("pair/" + a, [a](benchmark::State& st, int e2, int t) { bm_pair(st, e2, t, a); });
+    for (const auto& a : archs)
+      reg("bond/" + a, [a](benchmark::State& st, int e2, int t) { bm_bond(st, e2, t, a); });
     reg("walls", bm_walls);
     reg("gather_integrate", bm_gather);
     reg("step", bm_step);

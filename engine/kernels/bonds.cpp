@@ -9,7 +9,6 @@
 
 namespace asperity::detail {
 
-namespace {
 kernels::BondKernelArgs bond_kernel_args(State& s) {
   ParticleStore& p = s.p;
   BondStore& q = s.bonds;
@@ -26,6 +25,7 @@ kernels::BondKernelArgs bond_kernel_args(State& s) {
           s.rest_overlaps ? q.rest.data() : nullptr};
 }
 
+namespace {
 struct BondEnergy {
   double total, contact_kept, capped_fs_scale;
 };
