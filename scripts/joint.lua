@@ -71,6 +71,8 @@ local P = require("params").defaults{
   out = "out/joint",
   cache = "out/cache",
   threads = 0,
+  simd = "auto",           -- kernels of closure and shear: auto, an architecture, or "float" (the force laws
+                           -- in single precision, scalar: perf/runtime_vs_error.lua's study); packing: auto
   progress = true,
 }
 if P.scale == "thesis" then
@@ -230,9 +232,10 @@ local f = io.open(cache_file, "r")
 if f then
   f:close()
   log("reusing the cached specimen %s", cache_file)
-  world = asperity.load(cache_file, {threads = P.threads})
+  world = asperity.load(cache_file, {threads = P.threads, simd = P.simd})
 else
   world = build_specimen()
+  if P.simd ~= "auto" then world = asperity.load(cache_file, {threads = P.threads, simd = P.simd}) end
 end
 -- Numerical settings of the test (perf/runtime_vs_error.lua chose them; 0 keeps the engine's).
 local dt_safety = P.dt_safety > 0 and P.dt_safety or (P.model == "rigid" and 0 or 1.0)
@@ -607,6 +610,7 @@ local summary = {
   parameters = P,
   surface = {nx = nx, ny = ny, spacing = h, side_x = Lx, side_y = Ly},
   n_particles = #lower + #upper,
+  kernels = world:simd(),                    -- the kernel set of closure and shear
   left_out_particles = N - #lower - #upper,
   n_lower = #lower,
   n_upper = #upper,

@@ -60,6 +60,8 @@ local P = require("params").defaults{
                              -- "existing contact forces are kept"; scripts/README.md, "Stress-free bonds")
   dt_safety = 0,             -- time step / critical estimate in the tests (0: the engine's 0.8)
   threads = 1,
+  simd = "auto",             -- kernels of bonding and tests: auto, an architecture, or "float" (the force laws
+                             -- in single precision, scalar: perf/runtime_vs_error.lua's study); packing: auto
   out = "out/rev",
 }
 local out = asperity.mkdir(P.out)
@@ -120,7 +122,7 @@ local packing = timed("packing", make_packing)
 
 -- 2. Bonding, wall removal, relaxation --------------------------------------------------------------
 local function bonded(material)
-  local w = asperity.load(out .. "/packed.h5", {threads = P.threads})
+  local w = asperity.load(out .. "/packed.h5", {threads = P.threads, simd = P.simd})
   local count = w:install_bonds(material)
   for _, id in pairs(packing.box) do w:remove_wall(id) end
   local steps, reached, ratio = eq.run(w, {ratio = P.ratio, steps = 1000000})
@@ -203,7 +205,7 @@ local columns = {"step", "time [s]", "displacement [m]", "axial_stress [Pa]", "s
                  "slab_xz [Pa]", "slab_zx [Pa]"}
 local function run_test(checkpoint, name, velocity, o)
   local t0 = asperity.wall_time()
-  local w = asperity.load(out .. "/" .. checkpoint .. ".h5", {threads = P.threads})
+  local w = asperity.load(out .. "/" .. checkpoint .. ".h5", {threads = P.threads, simd = P.simd})
   if P.dt_safety > 0 then w:set_dt_safety(P.dt_safety) end
   local meter = specimen.strain_meter(w, gauges)
   local zlo, zhi = mean_z(w, gauges.lower), mean_z(w, gauges.upper)

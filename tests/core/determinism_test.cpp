@@ -128,6 +128,44 @@ TEST(Determinism, SimdKernelsEqualTheScalarReferenceBitwise) {
   }
 }
 
+// The "float" kernel set (issue 7's study of single precision): the same law, every operation of
+// it rounded to float, the geometry in double. On the random pairs it must agree with the double
+// reference to float precision (a wrong formula would be off by O(1)), and not bit for bit (the
+// float path must really run).
+TEST(Determinism, FloatStudyPairKernelAgreesWithDoubleToFloatPrecision) {
+  const std::size_t pairs = 4096;
+  for (bool rotation : {true, false}) {
+    RandomPairs ref(pairs, 11, true), got(pairs, 11, true);
+    ref.with_rest = got.with_rest = true;
+    const auto& sk = kernels::scalar_kernels();
+    const auto& fk = kernels::select_kernels("float");
+    EXPECT_STREQ(fk.name, "float");
+    const double slip_ref = (rotation ? sk.pair : sk.pair_norot)(ref.args(), 0, pairs);
+    const double slip_got = (rotation ? fk.pair : fk.pair_norot)(got.args(), 0, pairs);
+    EXPECT_NEAR(slip_got, slip_ref, 1e-5 * slip_ref);
+    // Each column against its largest magnitude: float keeps ~7 digits; the carried shear force
+    // goes through some forty float operations.
+    auto close = [&](const auto& u, const auto& v, double tol, const char* what) {
+      double scale = 0;
+      for (std::size_t k = 0; k < pairs; ++k) scale = std::max(scale, std::abs(u[k]));
+      std::size_t differ = 0;
+      for (std::size_t k = 0; k < pairs; ++k) {
+        EXPECT_NEAR(v[k], u[k], tol * scale) << what << " pair " << k;
+        differ += v[k] != u[k];
+      }
+      return differ;
+    };
+    EXPECT_EQ(close(ref.U, got.U, 1e-7, "overlap"), pairs) << "float values everywhere";
+    close(ref.nx, got.nx, 1e-7, "nx");
+    close(ref.fn, got.fn, 1e-6, "fn");
+    EXPECT_GT(close(ref.fsx, got.fsx, 1e-5, "fsx"), pairs / 4) << "touching pairs (a quarter to three quarters)";
+    close(ref.fsy, got.fsy, 1e-5, "fsy");
+    close(ref.fsz, got.fsz, 1e-5, "fsz");
+    close(ref.cx, got.cx, 1e-5, "cx");
+    close(ref.fz, got.fz, 1e-5, "fz");
+  }
+}
+
 namespace {
 // Random particles for the integrate kernel: free, in a group (not moved), rotation locked, one
 // non-finite velocity; damping on, gravity and applied forces; n not a multiple of the lanes.

@@ -39,6 +39,16 @@ for _, key in ipairs{"peak_shear_stress_mpa", "peak_displacement_mm", "residual_
 end
 assert(el.peak_shear_stress_mpa > 0 and el.normal_stiffness_mpa_per_mm > 0)
 
+-- The same joint with the force laws in single precision (simd=float, perf/runtime_vs_error.lua's
+-- study): it runs those kernels, and at this size lands within a few per cent of double.
+local fl = joint{surface = "S1", model = "elastic", simd = "float", out = out .. "/S1_elastic_float"}
+assert(fl.kernels == "float" and el.kernels ~= "float", "simd=float selects the float kernels for the test")
+for _, key in ipairs{"peak_shear_stress_mpa", "residual_shear_stress_mpa", "max_dilatancy_mm"} do
+  local rel = math.abs(fl[key] / el[key] - 1)
+  assert(rel < 0.05, ("float: %s %.5g against double %.5g (%.2g)"):format(key, fl[key], el[key], rel))
+end
+assert(math.abs(fl.energy_balance_error) < 0.01, "float: the energy ledger still closes")
+
 -- The fracture model on halves bonded stress-free (nothing locked into the bonds, so the strength
 -- check passes): bonds break while shearing, and the energy they held is booked as released, so
 -- the ledger still closes.
@@ -58,6 +68,9 @@ local d = asperity.read_h5(out .. "/S1_elastic/shear.h5", "/displacement")
 assert(d[#d] >= 1.0 - 1e-9, "sheared to 1 mm")
 print(("S4 peak %.3g MPa, S5 peak %.3g MPa; elastic S1: balance error %.2g, friction share %.2f"):format(
   s4.peak_shear_stress_mpa, s5.peak_shear_stress_mpa, el.energy_balance_error, el.energy_shares.friction))
+print(("float S1 elastic: peak %.5g (double %.5g), residual %.5g (%.5g), dilatancy %.5g (%.5g) mm"):format(
+  fl.peak_shear_stress_mpa, el.peak_shear_stress_mpa, fl.residual_shear_stress_mpa,
+  el.residual_shear_stress_mpa, fl.max_dilatancy_mm, el.max_dilatancy_mm))
 print(("fracture S1 (stress-free bonds): peak %.3g MPa, %d broken bonds, balance error %.2g"):format(
   fr.peak_shear_stress_mpa, fr.broken_bonds, fr.energy_balance_error))
 print(("[figure] normal stress held: p95 deviation S4 %.4f S5 %.4f S1 elastic %.4f; within 1 %%: %.3f %.3f %.3f; max %.3f %.3f %.3f"):format(
