@@ -1340,7 +1340,8 @@ void open_world(lua_State* L) {
        "A new world. Options (defaults): material = {kn = 0.1, ks = 0.01, friction = 0.5},\n"
        "density = 2500, damping = 0.7 (local), gravity = {0, 0, 0}, rotation = true, skin = 0\n"
        "(auto), dt = 0 (auto), dt_safety = 0.8, allow_dt_above_estimate = false,\n"
-       "dt_interval = 100, threads = 0 (all), simd = \"auto\" (scalar, sse4_2, avx2, avx512f),\n"
+       "dt_interval = 100, threads = 0 (all), simd = \"auto\" (scalar, sse4_2, avx2, avx512f;\n"
+       "float: the force laws in single precision, scalar, for the run-time study),\n"
        "track_energy = true, reorder_interval = 10, lock_bonded_rotation = true."},
       {"load", l_load, "asperity.load(path [, {threads=, simd=}]) -> World",
        "A world from a checkpoint written by world:save(path)."},
