@@ -254,16 +254,34 @@ Energies compute_energies(const State& s) {
   return e;
 }
 
+void run_stages(State& s, std::initializer_list<StageLoop*> stages) {
+  // Every thread meets the same loops in the same order; a stage's blocks are shared statically
+  // (the same split for the same thread count). The force stages do not wait for each other
+  // (they read the particles and write their own lists only); a stage after_barrier does.
+#pragma omp parallel num_threads(thread_count(s))
+  for (StageLoop* st : stages) {
+    if (st->after_barrier) {
+#pragma omp barrier
+    }
+    if (st->blocks == 0) continue;
+#pragma omp for schedule(static) nowait
+    for (std::size_t blk = 0; blk < st->blocks; ++blk) st->run(blk);
+  }
+  for (StageLoop* st : stages)
+    if (st->finish) st->finish();
+}
+
 void step_once(State& s) {
   const bool rebuilt = s.need_rebuild;
   if (rebuilt) build_neighbors(s);
   const bool estimate_due = s.step >= s.last_estimate_step + std::uint64_t(s.settings.dt_interval);
   if (!s.idle_valid) split_idle(s);
   if (rebuilt || estimate_due || s.dt <= 0) check_dt(s);
-  compute_pair_forces(s);
-  compute_bond_forces(s);
-  compute_wall_forces(s);
-  gather_and_integrate(s);
+  // The three force stages, then gather + integrate, in one parallel region (state.hpp,
+  // StageLoop); the ledgers and wall forces are summed after it.
+  StageLoop pairs = pair_stage(s), bonds = bond_stage(s), walls = wall_stage(s),
+            particles = integrate_stage(s);
+  run_stages(s, {&pairs, &bonds, &walls, &particles});
   update_servo_stiffness(s);
   advance_groups(s);
   for (auto& w : s.walls.walls) w.displacement += w.velocity * s.dt;

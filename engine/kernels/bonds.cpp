@@ -102,19 +102,26 @@ void refresh_bond_topology(State& s) {
   }
 }
 
-void compute_bond_forces(State& s) {
-  if (s.bonds.n == 0) return;
+StageLoop bond_stage(State& s) {
+  StageLoop st;
+  if (s.bonds.n == 0) return st;
   const auto args = bond_kernel_args(s);
   const auto kernel = s.any_rotating ? s.kernels->bond : s.kernels->bond_norot;
   const std::size_t total = s.bonds.padded;
-  const std::size_t blocks = (total + kPairBlock - 1) / kPairBlock;
-  s.bond_block_breaks.assign(blocks, 0.0);
+  st.blocks = (total + kPairBlock - 1) / kPairBlock;
+  s.bond_block_breaks.assign(st.blocks, 0.0);
   double* breaks = s.bond_block_breaks.data();
-#pragma omp parallel for schedule(static) num_threads(thread_count(s))
-  for (std::size_t blk = 0; blk < blocks; ++blk) {
+  st.run = [=](std::size_t blk) {
     const std::size_t begin = blk * kPairBlock;
     breaks[blk] = kernel(args, begin, std::min(total, begin + kPairBlock));
-  }
+  };
+  st.finish = [] {};  // the breaks are processed after the step (process_breaks)
+  return st;
+}
+
+void compute_bond_forces(State& s) {
+  StageLoop st = bond_stage(s);
+  run_stages(s, {&st});
 }
 
 void process_breaks(State& s) {

@@ -57,7 +57,7 @@ inline __attribute__((always_inline)) void add_incidences(const GatherColumns& c
 }
 }  // namespace
 
-void gather_and_integrate(State& s) {
+StageLoop integrate_stage(State& s) {
   ParticleStore& p = s.p;
   const PairStore& q = s.pairs;
   const Incidence& inc = s.incidence;
@@ -120,8 +120,13 @@ void gather_and_integrate(State& s) {
     Tx[i] = tx; Ty[i] = ty; Tz[i] = tz;
   };
 
-#pragma omp parallel for schedule(static) num_threads(thread_count(s))
-  for (std::size_t blk = 0; blk < blocks; ++blk) {
+  const std::uint8_t* inert = p.inert.data();
+  const std::int32_t* group = p.group.data();
+  const std::uint8_t* locked = p.rotation_locked.data();
+  StageLoop st;
+  st.blocks = blocks;
+  st.after_barrier = true;  // the forces of every stage before it are needed
+  st.run = [=, &s](std::size_t blk) {
     ParticleBlockResult r;
     if (!s.block_free[blk]) {
       // Rigid-group members only: their forces feed the group sums; nothing to integrate, and
@@ -129,7 +134,7 @@ void gather_and_integrate(State& s) {
       for (std::int32_t e = s.block_busy.start[blk]; e < s.block_busy.start[blk + 1]; ++e)
         gather(std::size_t(s.block_busy.entry[e]));
       s.particle_blocks[blk] = r;
-      continue;
+      return;
     }
     const std::size_t first = blk * kParticleBlock;
     const std::size_t end = std::min(n, first + kParticleBlock);
@@ -140,13 +145,13 @@ void gather_and_integrate(State& s) {
     a.free = free;
     a.spin = spin;
     for (std::size_t i = first; i < end; ++i) {
-      if (p.inert[i] || idle[i]) {  // no contacts, moved lazily with its group
+      if (inert[i] || idle[i]) {  // no contacts, moved lazily with its group
         free[i - first] = spin[i - first] = 0;
         continue;
       }
       gather(i);
-      free[i - first] = p.group[i] < 0 ? 1.0 : 0.0;  // else: moved with its group
-      spin[i - first] = (p.group[i] < 0 && !p.rotation_locked[i]) ? 1.0 : 0.0;
+      free[i - first] = group[i] < 0 ? 1.0 : 0.0;  // else: moved with its group
+      spin[i - first] = (group[i] < 0 && !locked[i]) ? 1.0 : 0.0;
     }
     for (std::size_t i = end; i < round_up(end, kMaxLanes); ++i) free[i - first] = spin[i - first] = 0;
     kernels::IntegrateSums sums;
@@ -159,7 +164,13 @@ void gather_and_integrate(State& s) {
     r.worst_step = sums.worst_step;
     r.worst = std::int32_t(sums.worst);
     s.particle_blocks[blk] = r;
-  }
+  };
+  return st;
+}
+
+void gather_and_integrate(State& s) {
+  StageLoop st = integrate_stage(s);
+  run_stages(s, {&st});
 }
 
 }  // namespace asperity::detail

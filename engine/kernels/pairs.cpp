@@ -15,21 +15,28 @@ kernels::PairKernelArgs pair_kernel_args(State& s) {
           s.rest_overlaps ? q.rest.data() : nullptr};
 }
 
-void compute_pair_forces(State& s) {
+StageLoop pair_stage(State& s) {
   const auto args = pair_kernel_args(s);
   const auto kernel = s.any_rotating ? s.kernels->pair : s.kernels->pair_norot;
   const std::size_t total = s.pairs.padded;
-  const std::size_t blocks = (total + kPairBlock - 1) / kPairBlock;
-  s.pair_block_slip.assign(blocks, 0.0);
+  StageLoop st;
+  st.blocks = (total + kPairBlock - 1) / kPairBlock;
+  s.pair_block_slip.assign(st.blocks, 0.0);
   double* slip = s.pair_block_slip.data();
-#pragma omp parallel for schedule(static) num_threads(thread_count(s))
-  for (std::size_t blk = 0; blk < blocks; ++blk) {
+  st.run = [=](std::size_t blk) {
     const std::size_t begin = blk * kPairBlock;
-    const std::size_t end = std::min(total, begin + kPairBlock);
-    slip[blk] = kernel(args, begin, end);
-  }
-  if (s.settings.track_energy)
-    for (std::size_t blk = 0; blk < blocks; ++blk) s.ledger.friction += slip[blk];
+    slip[blk] = kernel(args, begin, std::min(total, begin + kPairBlock));
+  };
+  st.finish = [&s, slip, blocks = st.blocks] {
+    if (s.settings.track_energy)
+      for (std::size_t blk = 0; blk < blocks; ++blk) s.ledger.friction += slip[blk];
+  };
+  return st;
+}
+
+void compute_pair_forces(State& s) {
+  StageLoop st = pair_stage(s);
+  run_stages(s, {&st});
 }
 
 }  // namespace asperity::detail

@@ -5,6 +5,7 @@
 // Also here: the triangle geometry (closest point with its feature, binning, queries).
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "kernels/contact_law.hpp"
 #include "state.hpp"
@@ -155,19 +156,28 @@ bool mesh_feature_contact_is_real(const Mesh& mesh, int t, int feature, const Ve
 }
 }  // namespace
 
-void compute_wall_forces(State& s) {
-  ParticleStore& p = s.p;
-  WallContacts& wc = s.walls.contacts;
-  auto& walls = s.walls.walls;
-  const std::size_t nw = walls.size();
-  const std::size_t blocks = (wc.n + kParticleBlock - 1) / kParticleBlock;
+StageLoop wall_stage(State& s) {
+  const std::size_t nw = s.walls.walls.size();
+  StageLoop st;
+  st.blocks = (s.walls.contacts.n + kParticleBlock - 1) / kParticleBlock;
   // Per block: slip energy, boundary work, and the force on each wall.
-  std::vector<double> slip(blocks, 0.0), work(blocks, 0.0);
-  std::vector<Vec3> force(blocks * nw);
-  const double dt = s.dt;
-  const bool rot = s.any_rotating;
-#pragma omp parallel for schedule(static) num_threads(thread_count(s))
-  for (std::size_t blk = 0; blk < blocks; ++blk) {
+  struct Sums {
+    std::vector<double> slip, work;
+    std::vector<Vec3> force;
+  };
+  auto sums = std::make_shared<Sums>();
+  sums->slip.assign(st.blocks, 0.0);
+  sums->work.assign(st.blocks, 0.0);
+  sums->force.assign(st.blocks * nw, Vec3{});
+  st.run = [&s, nw, sums](std::size_t blk) {
+    ParticleStore& p = s.p;
+    WallContacts& wc = s.walls.contacts;
+    const auto& walls = s.walls.walls;
+    const double dt = s.dt;
+    const bool rot = s.any_rotating;
+    double* slip = sums->slip.data();
+    double* work = sums->work.data();
+    Vec3* force = sums->force.data();
     const std::size_t end = std::min(wc.n, (blk + 1) * kParticleBlock);
     for (std::size_t k = blk * kParticleBlock; k < end; ++k) {
       const std::int32_t i = wc.particle[k];
@@ -223,15 +233,24 @@ void compute_wall_forces(State& s) {
       force[blk * nw + wc.wall[k]] -= f;
       work[blk] += dot(f, wall.velocity) * dt;  // model.md 8: boundary work of the wall
     }
-  }
-  for (auto& w : walls) w.force = {0, 0, 0};
-  for (std::size_t blk = 0; blk < blocks; ++blk) {
-    for (std::size_t w = 0; w < nw; ++w) walls[w].force += force[blk * nw + w];
-    if (s.settings.track_energy) {
-      s.ledger.friction += slip[blk];
-      s.ledger.boundary += work[blk];
+  };
+  st.finish = [&s, nw, sums, blocks = st.blocks] {
+    auto& walls = s.walls.walls;
+    for (auto& w : walls) w.force = {0, 0, 0};
+    for (std::size_t blk = 0; blk < blocks; ++blk) {
+      for (std::size_t w = 0; w < nw; ++w) walls[w].force += sums->force[blk * nw + w];
+      if (s.settings.track_energy) {
+        s.ledger.friction += sums->slip[blk];
+        s.ledger.boundary += sums->work[blk];
+      }
     }
-  }
+  };
+  return st;
+}
+
+void compute_wall_forces(State& s) {
+  StageLoop st = wall_stage(s);
+  run_stages(s, {&st});
 }
 
 }  // namespace asperity::detail
