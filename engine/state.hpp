@@ -136,7 +136,7 @@ struct StageLoop {
   std::size_t blocks = 0;
   bool after_barrier = false;  // its blocks start once every earlier stage's blocks are done
   std::function<void(std::size_t)> run;
-  std::function<void()> finish;
+  std::function<void()> finish;  // may be empty
 };
 StageLoop pair_stage(State& s);         // kernels/pairs.cpp
 StageLoop bond_stage(State& s);         // kernels/bonds.cpp

@@ -86,47 +86,40 @@ void bm_neighbors(benchmark::State& st, int edge, int threads) {
   set_counters(st, w.particle_count(), w.stats().pairs);
 }
 
-// The pair stage as engine/kernels/pairs.cpp runs it, with the kernel set of a given name.
+// A list kernel over `total` entries in the engine's blocks of kPairBlock (as kernels/pairs.cpp
+// and kernels/bonds.cpp run it), timed with `threads` threads.
+template <class Kernel, class Args>
+void time_blocks(benchmark::State& st, int threads, Kernel kernel, const Args& k, std::size_t total) {
+  const std::size_t blocks = (total + kPairBlock - 1) / kPairBlock;
+  std::vector<double> out(blocks);
+  for (auto _ : st) {
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (std::size_t blk = 0; blk < blocks; ++blk) {
+      const std::size_t begin = blk * kPairBlock;
+      out[blk] = kernel(k, begin, std::min(total, begin + kPairBlock));
+    }
+    benchmark::DoNotOptimize(out.data());
+    benchmark::ClobberMemory();
+  }
+}
+
+// The pair stage with the kernel set of a given name.
 void bm_pair(benchmark::State& st, int edge, int threads, std::string simd) {
   World& w = cache.get(edge, "pair");
   State& s = w.state();
   const auto& ks = asperity::kernels::select_kernels(simd);
-  const asperity::kernels::PairKernelArgs k = pair_kernel_args(s);
-  const std::size_t total = s.pairs.padded;
-  const std::size_t blocks = (total + kPairBlock - 1) / kPairBlock;
-  std::vector<double> slip(blocks);
-  for (auto _ : st) {
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (std::size_t blk = 0; blk < blocks; ++blk) {
-      const std::size_t begin = blk * kPairBlock;
-      slip[blk] = ks.pair(k, begin, std::min(total, begin + kPairBlock));
-    }
-    benchmark::DoNotOptimize(slip.data());
-    benchmark::ClobberMemory();
-  }
+  time_blocks(st, threads, ks.pair, pair_kernel_args(s), s.pairs.padded);
   set_counters(st, w.particle_count(), s.pairs.n);
   st.SetLabel(ks.name);
 }
 
-// The bond stage as engine/kernels/bonds.cpp runs it, with the kernel set of a given name.
+// The bond stage likewise.
 void bm_bond(benchmark::State& st, int edge, int threads, std::string simd) {
   World& w = cache.get(edge, "bond");
   State& s = w.state();
   const auto& ks = asperity::kernels::select_kernels(simd);
-  const auto kernel = s.any_rotating ? ks.bond : ks.bond_norot;
-  const asperity::kernels::BondKernelArgs k = bond_kernel_args(s);
-  const std::size_t total = s.bonds.padded;
-  const std::size_t blocks = (total + kPairBlock - 1) / kPairBlock;
-  std::vector<double> breaks(blocks);
-  for (auto _ : st) {
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (std::size_t blk = 0; blk < blocks; ++blk) {
-      const std::size_t begin = blk * kPairBlock;
-      breaks[blk] = kernel(k, begin, std::min(total, begin + kPairBlock));
-    }
-    benchmark::DoNotOptimize(breaks.data());
-    benchmark::ClobberMemory();
-  }
+  time_blocks(st, threads, s.any_rotating ? ks.bond : ks.bond_norot, bond_kernel_args(s),
+              s.bonds.padded);
   set_counters(st, w.particle_count(), 0);
   st.counters["bonds"] =
       benchmark::Counter(double(s.bonds.n) * double(st.iterations()), benchmark::Counter::kIsRate);

@@ -115,8 +115,7 @@ StageLoop bond_stage(State& s) {
     const std::size_t begin = blk * kPairBlock;
     breaks[blk] = kernel(args, begin, std::min(total, begin + kPairBlock));
   };
-  st.finish = [] {};  // the breaks are processed after the step (process_breaks)
-  return st;
+  return st;  // no finish: the breaks are processed after the step (process_breaks)
 }
 
 void compute_bond_forces(State& s) {

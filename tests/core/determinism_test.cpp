@@ -146,14 +146,7 @@ TEST(Determinism, FloatStudyPairKernelAgreesWithDoubleToFloatPrecision) {
     // Each column against its largest magnitude: float keeps ~7 digits; the carried shear force
     // goes through some forty float operations.
     auto close = [&](const auto& u, const auto& v, double tol, const char* what) {
-      double scale = 0;
-      for (std::size_t k = 0; k < pairs; ++k) scale = std::max(scale, std::abs(u[k]));
-      std::size_t differ = 0;
-      for (std::size_t k = 0; k < pairs; ++k) {
-        EXPECT_NEAR(v[k], u[k], tol * scale) << what << " pair " << k;
-        differ += v[k] != u[k];
-      }
-      return differ;
+      return test::agree_to_scale(u, v, pairs, tol, what);
     };
     EXPECT_EQ(close(ref.U, got.U, 1e-7, "overlap"), pairs) << "float values everywhere";
     close(ref.nx, got.nx, 1e-7, "nx");
