@@ -105,9 +105,10 @@ double bond_norot(const BondKernelArgs& k, std::size_t b, std::size_t e) {
 }  // namespace
 
 const KernelSet& float_study_kernels() {
-  // The integration is the scalar reference's, in double.
+  // The integration and the plane walls are the scalar reference's, in double.
   static const KernelSet set{"float", 1, &pair_rot, &pair_norot, &bond_rot, &bond_norot,
-                             scalar_kernels().integrate, scalar_kernels().integrate_norot};
+                             scalar_kernels().integrate, scalar_kernels().integrate_norot,
+                             scalar_kernels().plane_walls, scalar_kernels().plane_walls_norot};
   return set;
 }
 

@@ -54,6 +54,30 @@ struct BondKernelArgs {
 
 using BondKernel = double (*)(const BondKernelArgs&, std::size_t begin, std::size_t end);
 
+// Plane wall kernel (wall_loop.hpp): ball-plane contacts [begin, end) of the wall contact list,
+// all of them with planes; the plane is body a of the contact law (model.md 4), translating with
+// its velocity, not spinning. Reads the contacts' history and writes their new state, and per
+// contact the slip energy; the per-wall sums stay with the caller (kernels/walls.cpp), which adds
+// them in contact order. The wall columns (px .. friction) are indexed by wall number; px..pz is
+// the plane's current point (its point at creation plus its displacement).
+struct PlaneWallArgs {
+  const double* x; const double* y; const double* z;
+  const double* vx; const double* vy; const double* vz;
+  const double* wx; const double* wy; const double* wz;
+  const double* radius;
+  const std::int32_t* particle; const std::int32_t* wall;
+  double* nx; double* ny; double* nz;
+  double* fsx; double* fsy; double* fsz; double* fn; double* overlap;
+  double* slip;
+  const double* px; const double* py; const double* pz;
+  const double* pnx; const double* pny; const double* pnz;
+  const double* pvx; const double* pvy; const double* pvz;
+  const double* kn; const double* ks; const double* friction;
+  double dt;
+};
+
+using PlaneWallKernel = void (*)(const PlaneWallArgs&, std::size_t begin, std::size_t end);
+
 // Integrate kernel (integrate_loop.hpp): particles [begin, end), begin a multiple of kMaxLanes and
 // end padded up to one (the padding particles have free = 0). `free` and `spin` are 0/1 masks
 // indexed from begin; ax..az are null when no particle carries an applied force.
@@ -92,6 +116,8 @@ struct KernelSet {
   BondKernel bond_norot;
   IntegrateKernel integrate;        // with rotation
   IntegrateKernel integrate_norot;  // no particle can rotate: w and torques are not read
+  PlaneWallKernel plane_walls;       // with rotation
+  PlaneWallKernel plane_walls_norot;
 };
 
 const KernelSet& scalar_kernels();

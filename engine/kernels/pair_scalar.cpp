@@ -3,6 +3,7 @@
 #include "kernels/bond_loop.hpp"
 #include "kernels/integrate_loop.hpp"
 #include "kernels/pair_loop.hpp"
+#include "kernels/wall_loop.hpp"
 
 namespace asperity::kernels {
 namespace {
@@ -19,6 +20,9 @@ struct ScalarLanes {
   static double window(const double* p, std::int64_t) { return *p; }
   static double load(const double* p) { return *p; }
   static void store(double* p, double v) { *p = v; }
+  static double load_u(const double* p) { return *p; }
+  static void store_u(double* p, double v) { *p = v; }
+  static std::int64_t index32(const std::int32_t* p) { return *p; }
   static double sum(double v) { return v; }
   static double iota(double start) { return start; }
   static double lane(double v, std::size_t) { return v; }
@@ -44,11 +48,19 @@ void integrate_norot(const IntegrateArgs& k, std::size_t b, std::size_t e, Integ
   integrate_loop<ScalarLanes, false>(k, b, e, out);
 }
 
+void plane_walls_rot(const PlaneWallArgs& k, std::size_t b, std::size_t e) {
+  plane_wall_loop<ScalarLanes, true>(k, b, e);
+}
+void plane_walls_norot(const PlaneWallArgs& k, std::size_t b, std::size_t e) {
+  plane_wall_loop<ScalarLanes, false>(k, b, e);
+}
+
 }  // namespace
 
 const KernelSet& scalar_kernels() {
   static const KernelSet set{"scalar", 1, &pair_rot, &pair_norot, &bond_rot, &bond_norot,
-                             &integrate_rot, &integrate_norot};
+                             &integrate_rot, &integrate_norot, &plane_walls_rot,
+                             &plane_walls_norot};
   return set;
 }
 

@@ -9,6 +9,7 @@
 #include "kernels/bond_loop.hpp"
 #include "kernels/integrate_loop.hpp"
 #include "kernels/pair_loop.hpp"
+#include "kernels/wall_loop.hpp"
 
 #define ASPERITY_CAT2(a, b) a##b
 #define ASPERITY_CAT(a, b) ASPERITY_CAT2(a, b)
@@ -68,6 +69,18 @@ struct SimdLanes {
   }
   static Real load(const double* p) { return Real::load_aligned(p); }
   static void store(double* p, const Real& v) { v.store_aligned(p); }
+  // The wall contact list's columns (std::vector, any alignment) and its 32-bit indices.
+  static Real load_u(const double* p) { return Real::load_unaligned(p); }
+  static void store_u(double* p, const Real& v) { v.store_unaligned(p); }
+  static Index index32(const std::int32_t* p) {
+#if defined(__AVX512F__)
+    return _mm512_cvtepi32_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)));
+#elif defined(__AVX2__)
+    return _mm256_cvtepi32_epi64(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
+#else
+    return _mm_cvtepi32_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)));
+#endif
+  }
   static double sum(const Real& v) { return xsimd::hadd(v); }
   static Real iota(double start) {
     alignas(64) double l[size];
@@ -101,6 +114,13 @@ void integrate_norot(const IntegrateArgs& k, std::size_t b, std::size_t e, Integ
   integrate_loop<SimdLanes, false>(k, b, e, out);
 }
 
+void plane_walls_rot(const PlaneWallArgs& k, std::size_t b, std::size_t e) {
+  plane_wall_loop<SimdLanes, true>(k, b, e);
+}
+void plane_walls_norot(const PlaneWallArgs& k, std::size_t b, std::size_t e) {
+  plane_wall_loop<SimdLanes, false>(k, b, e);
+}
+
 }  // namespace
 
 #define ASPERITY_STR2(a) #a
@@ -109,7 +129,8 @@ void integrate_norot(const IntegrateArgs& k, std::size_t b, std::size_t e, Integ
 const KernelSet& ASPERITY_CAT(kernels_, ASPERITY_SIMD_ARCH)() {
   static const KernelSet set{ASPERITY_STR(ASPERITY_SIMD_ARCH), SimdLanes::size, &pair_rot,
                              &pair_norot, &bond_rot, &bond_norot,
-                             &integrate_rot, &integrate_norot};
+                             &integrate_rot, &integrate_norot, &plane_walls_rot,
+                             &plane_walls_norot};
   return set;
 }
 

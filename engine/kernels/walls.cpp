@@ -1,6 +1,8 @@
 // Stage `walls`: ball-wall contacts (planes and triangle meshes) with the same contact law as
 // ball-ball pairs (model.md 4), the wall in the role of body a: it translates with its prescribed
-// velocity and does not spin. Scalar: wall contacts are a surface term, few next to the pairs.
+// velocity and does not spin. Plane contacts run through the SIMD plane kernel
+// (kernels/wall_loop.hpp; scalar they took 15 % of the in-cache lattice step, perf/README.md),
+// mesh contacts here, scalar: their geometry branches per triangle feature.
 //
 // Also here: the triangle geometry (closest point with its feature, binning, queries).
 #include <algorithm>
@@ -158,52 +160,99 @@ bool mesh_feature_contact_is_real(const Mesh& mesh, int t, int feature, const Ve
 
 StageLoop wall_stage(State& s) {
   const std::size_t nw = s.walls.walls.size();
+  WallContacts& wc = s.walls.contacts;
+  wc.slip.resize(wc.n);  // an output only: a store read from a checkpoint has not sized it
   StageLoop st;
-  st.blocks = (s.walls.contacts.n + kParticleBlock - 1) / kParticleBlock;
-  // Per block: slip energy, boundary work, and the force on each wall.
+  st.blocks = (wc.n + kParticleBlock - 1) / kParticleBlock;
+  // Per block: slip energy, boundary work, and the force on each wall. Per wall: the columns the
+  // plane kernel reads (its current point, normal, velocity and material) and its kind.
   struct Sums {
     std::vector<double> slip, work;
     std::vector<Vec3> force;
+    std::vector<double> px, py, pz, nx, ny, nz, vx, vy, vz, kn, ks, friction;
+    std::vector<std::uint8_t> plane;
   };
   auto sums = std::make_shared<Sums>();
   sums->slip.assign(st.blocks, 0.0);
   sums->work.assign(st.blocks, 0.0);
   sums->force.assign(st.blocks * nw, Vec3{});
-  st.run = [&s, nw, sums](std::size_t blk) {
+  for (const Wall& w : s.walls.walls) {
+    const Vec3 point = w.point + w.displacement;
+    Sums& t = *sums;
+    t.px.push_back(point.x); t.py.push_back(point.y); t.pz.push_back(point.z);
+    t.nx.push_back(w.normal.x); t.ny.push_back(w.normal.y); t.nz.push_back(w.normal.z);
+    t.vx.push_back(w.velocity.x); t.vy.push_back(w.velocity.y); t.vz.push_back(w.velocity.z);
+    t.kn.push_back(w.material.kn); t.ks.push_back(w.material.ks);
+    t.friction.push_back(w.material.friction);
+    t.plane.push_back(w.kind == Wall::Kind::plane ? 1 : 0);
+  }
+  const ParticleStore& p = s.p;
+  const kernels::PlaneWallArgs plane_args{
+      p.x.data(), p.y.data(), p.z.data(), p.vx.data(), p.vy.data(), p.vz.data(), p.wx.data(),
+      p.wy.data(), p.wz.data(), p.radius.data(), wc.particle.data(), wc.wall.data(),
+      wc.nx.data(), wc.ny.data(), wc.nz.data(), wc.fsx.data(), wc.fsy.data(), wc.fsz.data(),
+      wc.fn.data(), wc.overlap.data(), wc.slip.data(), sums->px.data(), sums->py.data(),
+      sums->pz.data(), sums->nx.data(), sums->ny.data(), sums->nz.data(), sums->vx.data(),
+      sums->vy.data(), sums->vz.data(), sums->kn.data(), sums->ks.data(),
+      sums->friction.data(), s.dt};
+  const bool rot = s.any_rotating;
+  const auto plane_kernel = rot ? s.kernels->plane_walls : s.kernels->plane_walls_norot;
+  const auto plane_tail = rot ? kernels::scalar_kernels().plane_walls
+                              : kernels::scalar_kernels().plane_walls_norot;
+  const std::size_t lanes = s.kernels->lanes;
+  st.run = [&s, nw, sums, plane_args, plane_kernel, plane_tail, lanes](std::size_t blk) {
     ParticleStore& p = s.p;
     WallContacts& wc = s.walls.contacts;
     const auto& walls = s.walls.walls;
     const double dt = s.dt;
     const bool rot = s.any_rotating;
+    const std::uint8_t* plane = sums->plane.data();
     double* slip = sums->slip.data();
     double* work = sums->work.data();
     Vec3* force = sums->force.data();
-    const std::size_t end = std::min(wc.n, (blk + 1) * kParticleBlock);
-    for (std::size_t k = blk * kParticleBlock; k < end; ++k) {
-      const std::int32_t i = wc.particle[k];
-      const Wall& wall = walls[wc.wall[k]];
-      const Vec3 c{p.x[i], p.y[i], p.z[i]};
-      Vec3 n;
-      double U;
-      bool active = true;
-      if (wall.kind == Wall::Kind::plane) {
-        const double d = dot(c - (wall.point + wall.displacement), wall.normal);
-        n = wall.normal;
-        U = p.radius[i] - d;
-      } else {
-        const Mesh& mesh = s.walls.meshes[wall.mesh];
-        const auto& tri = mesh.triangles[wc.facet[k]];
-        int feature;
-        const Vec3 q = c - wall.displacement;
-        const Vec3 cp = closest_point_on_triangle(q, mesh.vertices[tri[0]], mesh.vertices[tri[1]],
-                                                  mesh.vertices[tri[2]], feature);
-        const Vec3 dv = q - cp;
-        const double d = norm(dv);
-        n = d > 0 ? dv / d : Vec3{0, 0, 1};
-        U = p.radius[i] - d;
-        // Only a touching triangle needs the (costly) test of whether a neighbour owns the contact.
-        active = !(U > 0) || feature == 0 || mesh_feature_contact_is_real(mesh, wc.facet[k], feature, q, d);
+    const std::size_t first = blk * kParticleBlock;
+    const std::size_t end = std::min(wc.n, first + kParticleBlock);
+    // The plane contacts, run by run: whole batches in SIMD, the rest by the scalar reference
+    // (the same values either way).
+    for (std::size_t k = first; k < end;) {
+      if (!plane[wc.wall[k]]) {
+        ++k;
+        continue;
       }
+      std::size_t e = k;
+      while (e < end && plane[wc.wall[e]]) ++e;
+      const std::size_t whole = k + (e - k) / lanes * lanes;
+      plane_kernel(plane_args, k, whole);
+      plane_tail(plane_args, whole, e);
+      k = e;
+    }
+    // The sums in contact order, and the mesh contacts.
+    for (std::size_t k = first; k < end; ++k) {
+      const Wall& wall = walls[wc.wall[k]];
+      if (plane[wc.wall[k]]) {
+        if (!(wc.overlap[k] > 0)) continue;  // no contact: no force
+        slip[blk] += wc.slip[k];
+        const double fn = wc.fn[k];
+        const Vec3 f{fn * wc.nx[k] + wc.fsx[k], fn * wc.ny[k] + wc.fsy[k], fn * wc.nz[k] + wc.fsz[k]};
+        force[blk * nw + wc.wall[k]] -= f;
+        work[blk] += dot(f, wall.velocity) * dt;  // model.md 8: boundary work of the wall
+        continue;
+      }
+      const std::int32_t i = wc.particle[k];
+      const Vec3 c{p.x[i], p.y[i], p.z[i]};
+      const Mesh& mesh = s.walls.meshes[wall.mesh];
+      const auto& tri = mesh.triangles[wc.facet[k]];
+      int feature;
+      const Vec3 q = c - wall.displacement;
+      const Vec3 cp = closest_point_on_triangle(q, mesh.vertices[tri[0]], mesh.vertices[tri[1]],
+                                                mesh.vertices[tri[2]], feature);
+      const Vec3 dv = q - cp;
+      const double d = norm(dv);
+      const Vec3 n = d > 0 ? dv / d : Vec3{0, 0, 1};
+      const double U = p.radius[i] - d;
+      // Only a touching triangle needs the (costly) test of whether a neighbour owns the contact.
+      const bool active =
+          !(U > 0) || feature == 0 || mesh_feature_contact_is_real(mesh, wc.facet[k], feature, q, d);
       if (!(U > 0) || !active) {
         // No contact: the law would give no force and forget the shear history [model.md 4]
         // (exactly: every output is selected to zero), so skip it. A particle near a mesh has

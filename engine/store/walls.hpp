@@ -53,12 +53,13 @@ struct WallContacts {
   std::size_t n = 0;
   std::vector<std::int32_t> particle, wall, facet;
   std::vector<double> nx, ny, nz, fsx, fsy, fsz, fn, overlap;
+  std::vector<double> slip;  // slip energy of the last step (plane contacts; an output only)
   std::vector<std::int32_t> start;  // per particle offsets (CSR), particles + 1
 
   void resize(std::size_t count) {
     n = count;
     for (auto* c : {&particle, &wall, &facet}) c->resize(count);
-    for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &overlap}) c->resize(count);
+    for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &overlap, &slip}) c->resize(count);
   }
 };
 

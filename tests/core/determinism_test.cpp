@@ -247,6 +247,108 @@ TEST(Determinism, SimdIntegrateEqualsTheScalarReferenceBitwise) {
   }
 }
 
+namespace {
+// Random ball-plane contacts in every state: touching or not, fresh (zero stored normal) or
+// carrying a shear force that sticks or slides, spinning, on moving planes of different
+// materials; a count that is not a multiple of the lanes.
+struct RandomPlaneContacts {
+  static constexpr std::size_t n = 1003, particles = 700, walls = 5;
+  std::vector<double> x, y, z, vx, vy, vz, wx, wy, wz, r;
+  std::vector<std::int32_t> particle, wall;
+  std::vector<double> nx, ny, nz, fsx, fsy, fsz, fn, U, slip;
+  std::vector<double> px, py, pz, pnx, pny, pnz, pvx, pvy, pvz, kn, ks, mu;
+  explicit RandomPlaneContacts(unsigned seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (std::size_t w = 0; w < walls; ++w) {
+      Vec3 m{u(rng), u(rng), u(rng)};
+      m = m / norm(m);
+      pnx.push_back(m.x); pny.push_back(m.y); pnz.push_back(m.z);
+      px.push_back(u(rng)); py.push_back(u(rng)); pz.push_back(u(rng));
+      const double speed = w % 2 ? 1e-3 : 0.0;
+      pvx.push_back(speed * u(rng)); pvy.push_back(speed * u(rng)); pvz.push_back(speed * u(rng));
+      kn.push_back(0.1 * (1 + w)); ks.push_back(0.03 * (1 + w)); mu.push_back(0.2 + 0.1 * w);
+    }
+    for (std::size_t i = 0; i < particles; ++i) {
+      r.push_back(5e-4 * (1 + 0.3 * u(rng)));
+      vx.push_back(1e-3 * u(rng)); vy.push_back(1e-3 * u(rng)); vz.push_back(1e-3 * u(rng));
+      wx.push_back(u(rng)); wy.push_back(u(rng)); wz.push_back(u(rng));
+      x.push_back(0); y.push_back(0); z.push_back(0);
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+      const auto i = std::int32_t(k % particles), w = std::int32_t(k % walls);
+      particle.push_back(i);
+      wall.push_back(w);
+      // The centre at a distance of 0.95 .. 1.05 R from the plane (the last contact of a
+      // particle sets its position; its earlier contact sees it wherever it ends up).
+      const double d = r[i] * (1 + 0.05 * u(rng));
+      const Vec3 t = cross(Vec3{pnx[w], pny[w], pnz[w]}, Vec3{u(rng), u(rng), u(rng)});  // in the plane
+      x[i] = px[w] + d * pnx[w] + t.x;
+      y[i] = py[w] + d * pny[w] + t.y;
+      z[i] = pz[w] + d * pnz[w] + t.z;
+      const bool fresh = k % 4 == 0;
+      Vec3 o{pnx[w] + 0.01 * u(rng), pny[w] + 0.01 * u(rng), pnz[w] + 0.01 * u(rng)};
+      o = o / norm(o);
+      nx.push_back(fresh ? 0.0 : o.x); ny.push_back(fresh ? 0.0 : o.y); nz.push_back(fresh ? 0.0 : o.z);
+      const double s = fresh ? 0.0 : (k % 3 ? 1e-6 : 1e-4);  // sticking or sliding
+      fsx.push_back(s * u(rng)); fsy.push_back(s * u(rng)); fsz.push_back(s * u(rng));
+    }
+    fn.assign(n, -1); U.assign(n, -1); slip.assign(n, -1);
+  }
+  kernels::PlaneWallArgs args() {
+    return {x.data(), y.data(), z.data(), vx.data(), vy.data(), vz.data(), wx.data(), wy.data(),
+            wz.data(), r.data(), particle.data(), wall.data(), nx.data(), ny.data(), nz.data(),
+            fsx.data(), fsy.data(), fsz.data(), fn.data(), U.data(), slip.data(), px.data(),
+            py.data(), pz.data(), pnx.data(), pny.data(), pnz.data(), pvx.data(), pvy.data(),
+            pvz.data(), kn.data(), ks.data(), mu.data(), 1e-3};
+  }
+};
+}  // namespace
+
+TEST(Determinism, SimdPlaneWallKernelEqualsTheScalarReferenceBitwise) {
+  using C = RandomPlaneContacts;
+  for (const auto& arch : available_simd_architectures()) {
+    const auto& simd = kernels::select_kernels(arch);
+    for (bool rotation : {true, false}) {
+      C ref(5), got(5);
+      const auto& sk = kernels::scalar_kernels();
+      (rotation ? sk.plane_walls : sk.plane_walls_norot)(ref.args(), 0, C::n);
+      // Whole batches from an odd start, as the wall stage calls it on runs of plane contacts;
+      // the scalar reference does the ends.
+      const std::size_t begin = 3, whole = begin + (C::n - begin) / simd.lanes * simd.lanes;
+      (rotation ? sk.plane_walls : sk.plane_walls_norot)(got.args(), 0, begin);
+      (rotation ? simd.plane_walls : simd.plane_walls_norot)(got.args(), begin, whole);
+      (rotation ? sk.plane_walls : sk.plane_walls_norot)(got.args(), whole, C::n);
+      const std::string what = arch + (rotation ? " rotation" : " no rotation");
+      auto same = [](const std::vector<double>& u, const std::vector<double>& v) {
+        return std::memcmp(u.data(), v.data(), u.size() * sizeof(double)) == 0;
+      };
+      for (auto [name, r, g] : {std::tuple{"nx", &ref.nx, &got.nx}, {"ny", &ref.ny, &got.ny},
+                                {"nz", &ref.nz, &got.nz}, {"fsx", &ref.fsx, &got.fsx},
+                                {"fsy", &ref.fsy, &got.fsy}, {"fsz", &ref.fsz, &got.fsz},
+                                {"fn", &ref.fn, &got.fn}, {"overlap", &ref.U, &got.U},
+                                {"slip", &ref.slip, &got.slip}})
+        EXPECT_TRUE(same(*r, *g)) << what << ": " << name;
+      // The scene covers the states: contacts and gaps, slipping and sticking.
+      std::size_t touching = 0, slipping = 0, sticking = 0;
+      for (std::size_t k = 0; k < C::n; ++k) {
+        touching += ref.U[k] > 0;
+        slipping += ref.slip[k] > 0;
+        sticking += ref.U[k] > 0 && ref.slip[k] == 0 && ref.fsx[k] != 0;
+        // The plane's normal, and the overlap from the centre's distance to the plane.
+        ASSERT_EQ(ref.nx[k], ref.pnx[ref.wall[k]]);
+        if (!(ref.U[k] > 0)) {
+          EXPECT_TRUE(ref.fn[k] == 0 && ref.fsx[k] == 0 && ref.slip[k] == 0) << k;
+        }
+      }
+      EXPECT_GT(touching, C::n / 4);
+      EXPECT_LT(touching, 3 * C::n / 4);
+      EXPECT_GT(slipping, 10u);
+      EXPECT_GT(sticking, 10u);
+    }
+  }
+}
+
 TEST(Determinism, WholeRunSameWithEveryArchitecture) {
   std::vector<double> reference;
   for (const auto& arch : available_simd_architectures()) {
