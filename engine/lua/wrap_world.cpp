@@ -1311,7 +1311,7 @@ void open_world(lua_State* L) {
        "Critical time step estimate now, without the safety factor."},
       {"step", world_step, "world:step() -> n", "Steps done so far."},
       {"time", world_time, "world:time() -> s", "Simulated time."},
-      {"set_threads", world_set_threads, "world:set_threads(n)", "OpenMP threads (0: all)."},
+      {"set_threads", world_set_threads, "world:set_threads(n)", "OpenMP threads (0: automatic, by the number of pairs and bonds, up to all cores)."},
       {"simd", world_simd, "world:simd() -> name", "SIMD architecture of the kernels."},
       {"stats", world_stats, "world:stats() -> table", "Rebuilds, reorders, pairs, contacts, wall_contacts."},
       {"rebuild_neighbors", world_rebuild_neighbors, "world:rebuild_neighbors()", "Rebuilds the pair list now."},
@@ -1340,7 +1340,7 @@ void open_world(lua_State* L) {
        "A new world. Options (defaults): material = {kn = 0.1, ks = 0.01, friction = 0.5},\n"
        "density = 2500, damping = 0.7 (local), gravity = {0, 0, 0}, rotation = true, skin = 0\n"
        "(auto), dt = 0 (auto), dt_safety = 0.8, allow_dt_above_estimate = false,\n"
-       "dt_interval = 100, threads = 0 (all), simd = \"auto\" (scalar, sse4_2, avx2, avx512f;\n"
+       "dt_interval = 100, threads = 0 (automatic), simd = \"auto\" (scalar, sse4_2, avx2, avx512f;\n"
        "float: the force laws in single precision, scalar, for the run-time study),\n"
        "track_energy = true, reorder_interval = 10, lock_bonded_rotation = true."},
       {"load", l_load, "asperity.load(path [, {threads=, simd=}]) -> World",

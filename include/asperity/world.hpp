@@ -53,8 +53,8 @@ struct WorldSettings {
   double dt_safety = 0.8;
   bool allow_dt_above_estimate = false;  // a fixed dt above the estimate is an error unless set
   int dt_interval = 100;            // steps between critical-step estimates (also at each rebuild)
-  int threads = 0;                  // OpenMP threads; 0: automatic (1 per 20 000 particles, up to
-                                    // the cores available)
+  int threads = 0;                  // OpenMP threads; 0: automatic (1 per 10 000 pairs or 5 000
+                                    // bonds, or per 20 000 particles, up to the cores available)
   std::string simd = "auto";        // "auto", "scalar", "sse4_2", "avx2", "avx512f"
   bool track_energy = true;         // friction, damping and boundary work ledgers (model.md 8)
   int reorder_interval = 10;        // neighbour rebuilds between space-filling-curve reorders; 0: never

@@ -12,6 +12,7 @@
 #include "core/aligned.hpp"
 #include "kernels/kernels.hpp"
 #include "scenes.hpp"
+#include "state.hpp"
 
 using namespace asperity;
 
@@ -33,6 +34,31 @@ TEST(Determinism, FullStateBitwiseIdenticalWithOneAndTwoThreads) {
   EXPECT_EQ(ea.friction, eb.friction);
   EXPECT_EQ(ea.damping, eb.damping);
   EXPECT_EQ(ea.strain, eb.strain);
+}
+
+// The automatic thread count follows the force work (state.hpp, thread_count): the default
+// joint's elastic specimen (4 031 pairs, 9 098 bonds) takes a second thread, its rigid twin
+// (161 pairs) and small scenes do not; a set count always wins.
+TEST(Determinism, AutomaticThreadCountFollowsTheWork) {
+  detail::State s;
+  s.max_threads = 8;
+  s.p.n = 3972;
+  s.pairs.n = 161;
+  EXPECT_EQ(detail::thread_count(s), 1);
+  s.pairs.n = 4031;
+  s.bonds.n = 9098;
+  EXPECT_EQ(detail::thread_count(s), 3);
+  s.max_threads = 2;
+  EXPECT_EQ(detail::thread_count(s), 2);
+  s.max_threads = 8;
+  s.pairs.n = 30496;  // lattice n = 22
+  s.bonds.n = 0;
+  EXPECT_EQ(detail::thread_count(s), 4);
+  s.pairs.n = 0;  // before the first pair list: by particles
+  s.p.n = 64000;
+  EXPECT_EQ(detail::thread_count(s), 4);
+  s.settings.threads = 1;
+  EXPECT_EQ(detail::thread_count(s), 1);
 }
 
 TEST(Determinism, SameSeedSameRun) {
