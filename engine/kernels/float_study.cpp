@@ -87,6 +87,9 @@ struct FloatLanes {
   static F32 load(const double* p) { return F32(*p); }
   static void store(double* p, const F32& v) { *p = double(v.v); }
   static double sum(const F32& v) { return double(v.v); }
+  static void store_records(double* rec, const F32* v) {
+    for (int j = 0; j < 8; ++j) rec[j] = double(v[j].v);
+  }
 };
 
 double pair_rot(const PairKernelArgs& k, std::size_t b, std::size_t e) {
@@ -105,10 +108,11 @@ double bond_norot(const BondKernelArgs& k, std::size_t b, std::size_t e) {
 }  // namespace
 
 const KernelSet& float_study_kernels() {
-  // The integration and the plane walls are the scalar reference's, in double.
+  // The integration, the plane walls and the gather are the scalar reference's, in double.
   static const KernelSet set{"float", 1, &pair_rot, &pair_norot, &bond_rot, &bond_norot,
                              scalar_kernels().integrate, scalar_kernels().integrate_norot,
-                             scalar_kernels().plane_walls, scalar_kernels().plane_walls_norot};
+                             scalar_kernels().plane_walls, scalar_kernels().plane_walls_norot,
+                             scalar_kernels().gather_pairs};
   return set;
 }
 

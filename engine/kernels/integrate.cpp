@@ -1,18 +1,17 @@
 // Stages `gather` and `integrate`, fused per block of kParticleBlock particles: the gather sums
 // each particle's pair, bond and wall contributions in the fixed order of its incidence lists
-// into fx..tz (scalar: the incidence lists are irregular), then the integrate kernel advances the
-// block with leapfrog and local damping (kernels/integrate_loop.hpp, SIMD; particles of rigid
-// groups are moved by bodies/groups.cpp). The block's forces are still in L1/L2 when the kernel
-// reads them back.
+// into fx..tz, then the integrate kernel advances the block with leapfrog and local damping
+// (kernels/integrate_loop.hpp, SIMD; particles of rigid groups are moved by bodies/groups.cpp).
+// The block's forces are still in L1/L2 when the kernel reads them back.
 //
 // Per-pair results give force and torques without anything else (model.md 4):
 //   on b: F = Fn n + Fs, torque (xc - xb) x F = -(Rb - U/2) n x Fs
 //   on a: -F,            torque (xc - xa) x (-F) = -(Ra - U/2) n x Fs
 // F and n x Fs (and a bond's beam moment) are computed by the SIMD pair and bond kernels, eight
-// pairs at a time; here only the lever arm, which differs per side, is applied. The operations
-// are those this loop did itself before (so the results are bitwise the same), but the scalar
-// gather reads 7 numbers per pair incidence instead of 8, and 10 per bond incidence instead of
-// 16, and does a third of the arithmetic.
+// pairs at a time; here only the lever arm, which differs per side, is applied. A pair's numbers
+// are one 64-byte record (store/pairs.hpp), which the pair gather kernel (gather_loop.hpp) reads
+// as two vectors; the bond and wall incidences follow in scalar code. The operations are those
+// the scalar gather did (so the results are bitwise the same).
 #include <cmath>
 
 #include "state.hpp"
@@ -20,23 +19,21 @@
 namespace asperity::detail {
 
 namespace {
-// What the gather reads of the pair or the bond list: the incidence of each particle, the
-// kernels' force on b and n x Fs, the overlap for the lever arm, and for bonds the beam moment.
-// Raw pointers held by value: the stores to the force columns cannot make the compiler reload
-// them (a vector's data pointer reached through a reference can look aliased).
-struct GatherColumns {
+// What the gather reads of the bond list: the incidence of each particle, and the kernel's force
+// on b, n x Fs, the overlap for the lever arm and the beam moment. Raw pointers held by value: the
+// stores to the force columns cannot make the compiler reload them (a vector's data pointer
+// reached through a reference can look aliased).
+struct BondColumns {
   const std::int32_t* start;
-  const std::int64_t* entry;  // (index << 1) | (particle is b)
-  const double *fx, *fy, *fz, *cx, *cy, *cz, *overlap;
-  const double *mx = nullptr, *my = nullptr, *mz = nullptr;  // bonds only
+  const std::int64_t* entry;
+  const double *fx, *fy, *fz, *cx, *cy, *cz, *overlap, *mx, *my, *mz;
 };
 
-// Adds particle i's contributions from one list to (f, t), in the fixed order of its incidence.
-template <bool Moment>
-inline __attribute__((always_inline)) void add_incidences(const GatherColumns& c, std::size_t i,
-                                                          double R, double& fx, double& fy,
-                                                          double& fz, double& tx, double& ty,
-                                                          double& tz) {
+// Adds particle i's contributions from the bond list to (f, t), in the fixed order of its
+// incidence; the beam's moment acts on b, its negative on a.
+inline __attribute__((always_inline)) void add_bonds(const BondColumns& c, std::size_t i, double R,
+                                                     double& fx, double& fy, double& fz,
+                                                     double& tx, double& ty, double& tz) {
   for (std::int32_t e = c.start[i]; e < c.start[i + 1]; ++e) {
     const std::int64_t k = c.entry[e] >> 1;
     const double sgn = (c.entry[e] & 1) ? 1.0 : -1.0;
@@ -44,15 +41,9 @@ inline __attribute__((always_inline)) void add_incidences(const GatherColumns& c
     fy += sgn * c.fy[k];
     fz += sgn * c.fz[k];
     const double lever = R - 0.5 * c.overlap[k];
-    if constexpr (Moment) {  // the beam's moment acts on b, its negative on a
-      tx += sgn * c.mx[k] - lever * c.cx[k];
-      ty += sgn * c.my[k] - lever * c.cy[k];
-      tz += sgn * c.mz[k] - lever * c.cz[k];
-    } else {
-      tx -= lever * c.cx[k];
-      ty -= lever * c.cy[k];
-      tz -= lever * c.cz[k];
-    }
+    tx += sgn * c.mx[k] - lever * c.cx[k];
+    ty += sgn * c.my[k] - lever * c.cy[k];
+    tz += sgn * c.mz[k] - lever * c.cz[k];
   }
 }
 }  // namespace
@@ -81,11 +72,15 @@ StageLoop integrate_stage(State& s) {
       applied ? p.az.data() : nullptr, nullptr, nullptr,
       s.dt, s.settings.local_damping, g.x, g.y, g.z};
 
-  // One particle's pair, bond and wall contributions, in the fixed order of its incidence lists.
-  // Raw pointers captured by value (see GatherColumns).
-  const GatherColumns pairs{inc.start.data(), inc.entry.data(), q.fx.data(), q.fy.data(),
-                            q.fz.data(), q.cx.data(), q.cy.data(), q.cz.data(), q.overlap.data()};
-  const GatherColumns bonds{binc.start.data(), binc.entry.data(), bq.fx.data(), bq.fy.data(),
+  // The pair sums of a range of particles (the kernel skips inert and idle ones, as below).
+  const auto gather_pairs = s.kernels->gather_pairs;
+  const kernels::PairGatherArgs pair_args{inc.start.data(), inc.entry.data(), q.out.data(),
+                                          p.radius.data(), p.inert.data(), idle, p.fx.data(),
+                                          p.fy.data(), p.fz.data(), p.tx.data(), p.ty.data(),
+                                          p.tz.data()};
+  // One particle's bond and wall contributions, added to its pair sums in the fixed order of its
+  // incidence lists. Raw pointers captured by value (see BondColumns).
+  const BondColumns bonds{binc.start.data(), binc.entry.data(), bq.fx.data(), bq.fy.data(),
                             bq.fz.data(), bq.cx.data(), bq.cy.data(), bq.cz.data(),
                             bq.overlap.data(), bq.mx.data(), bq.my.data(), bq.mz.data()};
   const std::int32_t* wstart = wc.start.data();
@@ -95,29 +90,38 @@ StageLoop integrate_stage(State& s) {
                *ay = applied ? p.ay.data() : nullptr, *az = applied ? p.az.data() : nullptr;
   double *Fx = p.fx.data(), *Fy = p.fy.data(), *Fz = p.fz.data(), *Tx = p.tx.data(), *Ty = p.ty.data(),
          *Tz = p.tz.data();
-  auto gather = [=](std::size_t i) __attribute__((always_inline)) {  // two call sites: keep it inline
-    double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
-    const double R = radius[i];
-    add_incidences<false>(pairs, i, R, fx, fy, fz, tx, ty, tz);
-    add_incidences<true>(bonds, i, R, fx, fy, fz, tx, ty, tz);  // contact + parallel bond
-    for (std::int32_t k = wstart[i]; k < wstart[i + 1]; ++k) {
-      const double nx = wnx[k], ny = wny[k], nz = wnz[k];
-      const double sx = wsx[k], sy = wsy[k], sz = wsz[k], fn = wfn[k];
-      fx += fn * nx + sx;
-      fy += fn * ny + sy;
-      fz += fn * nz + sz;
-      const double lever = R - 0.5 * wu[k];
-      tx -= lever * (ny * sz - nz * sy);
-      ty -= lever * (nz * sx - nx * sz);
-      tz -= lever * (nx * sy - ny * sx);
-    }
-    if (applied) {
-      fx += ax[i];
-      fy += ay[i];
-      fz += az[i];
-    }
+  // Particle i's bond, wall and applied terms, added to its pair sums in that order.
+  auto add_bonds_to = [=](std::size_t i) __attribute__((always_inline)) {
+    double fx = Fx[i], fy = Fy[i], fz = Fz[i], tx = Tx[i], ty = Ty[i], tz = Tz[i];
+    add_bonds(bonds, i, radius[i], fx, fy, fz, tx, ty, tz);  // contact + parallel bond
     Fx[i] = fx; Fy[i] = fy; Fz[i] = fz;
     Tx[i] = tx; Ty[i] = ty; Tz[i] = tz;
+  };
+  const std::int32_t* wparticle = wc.particle.data();
+  auto add_wall = [=](std::int32_t k) __attribute__((always_inline)) {
+    const std::size_t i = std::size_t(wparticle[k]);
+    const double nx = wnx[k], ny = wny[k], nz = wnz[k];
+    const double sx = wsx[k], sy = wsy[k], sz = wsz[k], fn = wfn[k];
+    Fx[i] += fn * nx + sx;
+    Fy[i] += fn * ny + sy;
+    Fz[i] += fn * nz + sz;
+    const double lever = radius[i] - 0.5 * wu[k];
+    Tx[i] -= lever * (ny * sz - nz * sy);
+    Ty[i] -= lever * (nz * sx - nx * sz);
+    Tz[i] -= lever * (nx * sy - ny * sx);
+  };
+  auto add_applied = [=](std::size_t i) __attribute__((always_inline)) {
+    Fx[i] += ax[i];
+    Fy[i] += ay[i];
+    Fz[i] += az[i];
+  };
+  const bool any_bonds = bq.n > 0;
+  // The whole gather of one particle (the pair kernel's part included).
+  auto gather = [=](std::size_t i) __attribute__((always_inline)) {
+    gather_pairs(pair_args, i, i + 1);
+    if (any_bonds) add_bonds_to(i);
+    for (std::int32_t k = wstart[i]; k < wstart[i + 1]; ++k) add_wall(k);
+    if (applied) add_applied(i);
   };
 
   const std::uint8_t* inert = p.inert.data();
@@ -144,14 +148,23 @@ StageLoop integrate_stage(State& s) {
     kernels::IntegrateArgs a = args;
     a.free = free;
     a.spin = spin;
+    // The gather in passes over the block, each particle's terms in the order pairs, bonds,
+    // walls, applied (as `gather`): inert and idle particles have none and are skipped.
+    gather_pairs(pair_args, first, end);
+    if (any_bonds)
+      for (std::size_t i = first; i < end; ++i)
+        if (!inert[i] && !idle[i]) add_bonds_to(i);
+    for (std::int32_t k = wstart[first]; k < wstart[end]; ++k)
+      if (!inert[wparticle[k]] && !idle[wparticle[k]]) add_wall(k);
+    if (applied)
+      for (std::size_t i = first; i < end; ++i)
+        if (!inert[i] && !idle[i]) add_applied(i);
     for (std::size_t i = first; i < end; ++i) {
-      if (inert[i] || idle[i]) {  // no contacts, moved lazily with its group
-        free[i - first] = spin[i - first] = 0;
-        continue;
-      }
-      gather(i);
-      free[i - first] = group[i] < 0 ? 1.0 : 0.0;  // else: moved with its group
-      spin[i - first] = (group[i] < 0 && !locked[i]) ? 1.0 : 0.0;
+      // Only free particles are integrated: inert and idle ones move lazily with their group,
+      // other members with it (bodies/groups.cpp).
+      const bool moves = !inert[i] && !idle[i] && group[i] < 0;
+      free[i - first] = moves ? 1.0 : 0.0;
+      spin[i - first] = (moves && !locked[i]) ? 1.0 : 0.0;
     }
     for (std::size_t i = end; i < round_up(end, kMaxLanes); ++i) free[i - first] = spin[i - first] = 0;
     kernels::IntegrateSums sums;

@@ -16,8 +16,9 @@ struct PairKernelArgs {
   double* nx; double* ny; double* nz;
   double* fsx; double* fsy; double* fsz;
   double* fn; double* overlap;
-  double* fx; double* fy; double* fz;  // outputs for the gather (store/pairs.hpp)
-  double* cx; double* cy; double* cz;
+  // Output for the gather (store/pairs.hpp): per pair the record fx fy fz U cx cy cz 0, eight
+  // doubles from out + 8 k (64-byte aligned).
+  double* out;
   double kn, ks, friction, dt;
   // Length of the particle columns. A batch whose a-side particles lie within one lane-width
   // window [a0, a0 + lanes) that fits in the columns loads them with one contiguous load and a
@@ -78,6 +79,23 @@ struct PlaneWallArgs {
 
 using PlaneWallKernel = void (*)(const PlaneWallArgs&, std::size_t begin, std::size_t end);
 
+// Pair gather kernel (gather_loop.hpp): for each particle i in [begin, end) not marked in `inert`
+// or `idle` (either may be null), the sum over its pair incidences, in their order, of the force
+// and torque the pair records give it (store/pairs.hpp: record fx fy fz U cx cy cz 0; on b: +F,
+// on a: -F; on either: -(R - U/2) n x Fs), written to fx..tz[i]. The bonds, walls and applied
+// forces are added to these by the caller (kernels/integrate.cpp).
+struct PairGatherArgs {
+  const std::int32_t* start;  // incidence CSR (store/pairs.hpp, Incidence)
+  const std::int64_t* entry;  // (pair << 1) | (particle is b)
+  const double* records;      // 8 doubles per pair
+  const double* radius;
+  const std::uint8_t* inert; const std::uint8_t* idle;
+  double* fx; double* fy; double* fz;
+  double* tx; double* ty; double* tz;
+};
+
+using PairGatherKernel = void (*)(const PairGatherArgs&, std::size_t begin, std::size_t end);
+
 // Integrate kernel (integrate_loop.hpp): particles [begin, end), begin a multiple of kMaxLanes and
 // end padded up to one (the padding particles have free = 0). `free` and `spin` are 0/1 masks
 // indexed from begin; ax..az are null when no particle carries an applied force.
@@ -118,6 +136,7 @@ struct KernelSet {
   IntegrateKernel integrate_norot;  // no particle can rotate: w and torques are not read
   PlaneWallKernel plane_walls;       // with rotation
   PlaneWallKernel plane_walls_norot;
+  PairGatherKernel gather_pairs;
 };
 
 const KernelSet& scalar_kernels();

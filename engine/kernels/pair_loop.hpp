@@ -43,11 +43,11 @@ double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
     Lanes::store(k.fsx + i, fx); Lanes::store(k.fsy + i, fy); Lanes::store(k.fsz + i, fz);
     Lanes::store(k.fn + i, fn);
     Lanes::store(k.overlap + i, U);
-    // For the gather (kernels/integrate.cpp), with the operations it would do per side.
-    Lanes::store(k.fx + i, fn * nx + fx); Lanes::store(k.fy + i, fn * ny + fy);
-    Lanes::store(k.fz + i, fn * nz + fz);
-    Lanes::store(k.cx + i, ny * fz - nz * fy); Lanes::store(k.cy + i, nz * fx - nx * fz);
-    Lanes::store(k.cz + i, nx * fy - ny * fx);
+    // For the gather (kernels/integrate.cpp), with the operations it would do per side: the
+    // record fx fy fz U cx cy cz 0 of each pair (store/pairs.hpp).
+    const T record[8] = {fn * nx + fx, fn * ny + fy, fn * nz + fz, U,
+                         ny * fz - nz * fy, nz * fx - nx * fz, nx * fy - ny * fx, T(0.0)};
+    Lanes::store_records(k.out + 8 * i, record);
   }
   return Lanes::sum(slip_sum);
 }

@@ -1,6 +1,7 @@
 // Scalar reference of the pair kernel: one pair at a time, plain doubles. It is the definition
 // the SIMD kernels are tested against, and what a build without SIMD runs.
 #include "kernels/bond_loop.hpp"
+#include "kernels/gather_loop.hpp"
 #include "kernels/integrate_loop.hpp"
 #include "kernels/pair_loop.hpp"
 #include "kernels/wall_loop.hpp"
@@ -24,6 +25,9 @@ struct ScalarLanes {
   static void store_u(double* p, double v) { *p = v; }
   static std::int64_t index32(const std::int32_t* p) { return *p; }
   static double sum(double v) { return v; }
+  static void store_records(double* rec, const double* v) {
+    for (int j = 0; j < 8; ++j) rec[j] = v[j];
+  }
   static double iota(double start) { return start; }
   static double lane(double v, std::size_t) { return v; }
 };
@@ -55,12 +59,16 @@ void plane_walls_norot(const PlaneWallArgs& k, std::size_t b, std::size_t e) {
   plane_wall_loop<ScalarLanes, false>(k, b, e);
 }
 
+void gather_pairs(const PairGatherArgs& g, std::size_t b, std::size_t e) {
+  gather_pairs_scalar(g, b, e);
+}
+
 }  // namespace
 
 const KernelSet& scalar_kernels() {
   static const KernelSet set{"scalar", 1, &pair_rot, &pair_norot, &bond_rot, &bond_norot,
                              &integrate_rot, &integrate_norot, &plane_walls_rot,
-                             &plane_walls_norot};
+                             &plane_walls_norot, &gather_pairs};
   return set;
 }
 

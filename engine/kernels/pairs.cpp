@@ -10,8 +10,7 @@ kernels::PairKernelArgs pair_kernel_args(State& s) {
   return {p.x.data(), p.y.data(), p.z.data(), p.vx.data(), p.vy.data(), p.vz.data(),
           p.wx.data(), p.wy.data(), p.wz.data(), p.radius.data(), q.a.data(), q.b.data(),
           q.nx.data(), q.ny.data(), q.nz.data(), q.fsx.data(), q.fsy.data(), q.fsz.data(),
-          q.fn.data(), q.overlap.data(), q.fx.data(), q.fy.data(), q.fz.data(), q.cx.data(),
-          q.cy.data(), q.cz.data(), m.kn, m.ks, m.friction, s.dt, p.capacity,
+          q.fn.data(), q.overlap.data(), q.out.data(), m.kn, m.ks, m.friction, s.dt, p.capacity,
           s.rest_overlaps ? q.rest.data() : nullptr};
 }
 

@@ -7,6 +7,7 @@
 #include <xsimd/xsimd.hpp>
 
 #include "kernels/bond_loop.hpp"
+#include "kernels/gather_loop.hpp"
 #include "kernels/integrate_loop.hpp"
 #include "kernels/pair_loop.hpp"
 #include "kernels/wall_loop.hpp"
@@ -82,6 +83,50 @@ struct SimdLanes {
 #endif
   }
   static double sum(const Real& v) { return xsimd::hadd(v); }
+  // Records (store/pairs.hpp): v[j] holds value j of the batch's pairs; pair p's eight values go
+  // to rec[8 p .. 8 p + 7]. A transpose of eight rows, then one aligned full-line store per pair
+  // (or two half-line stores on AVX2, four quarters on SSE).
+  static void store_records(double* rec, const Real* v) {
+#if defined(__AVX512F__)
+    // Rows of pairs -> pairs of two-element runs -> half records -> records.
+    const __m512d t0 = _mm512_unpacklo_pd(v[0], v[1]), t1 = _mm512_unpackhi_pd(v[0], v[1]);
+    const __m512d t2 = _mm512_unpacklo_pd(v[2], v[3]), t3 = _mm512_unpackhi_pd(v[2], v[3]);
+    const __m512d t4 = _mm512_unpacklo_pd(v[4], v[5]), t5 = _mm512_unpackhi_pd(v[4], v[5]);
+    const __m512d t6 = _mm512_unpacklo_pd(v[6], v[7]), t7 = _mm512_unpackhi_pd(v[6], v[7]);
+    // t0 = v0_0 v1_0 v0_2 v1_2 v0_4 v1_4 v0_6 v1_6 (vj_p: value j of pair p); t1 the odd pairs.
+    const __m512i lo = _mm512_setr_epi64(0, 1, 8, 9, 4, 5, 12, 13);
+    const __m512i hi = _mm512_setr_epi64(2, 3, 10, 11, 6, 7, 14, 15);
+    // u0 = values 0..3 of pairs 0 and 4, u1 of pairs 1 and 5, u2 of 2 and 6, u3 of 3 and 7; w*
+    // the same for values 4..7.
+    const __m512d u0 = _mm512_permutex2var_pd(t0, lo, t2), u2 = _mm512_permutex2var_pd(t0, hi, t2);
+    const __m512d u1 = _mm512_permutex2var_pd(t1, lo, t3), u3 = _mm512_permutex2var_pd(t1, hi, t3);
+    const __m512d w0 = _mm512_permutex2var_pd(t4, lo, t6), w2 = _mm512_permutex2var_pd(t4, hi, t6);
+    const __m512d w1 = _mm512_permutex2var_pd(t5, lo, t7), w3 = _mm512_permutex2var_pd(t5, hi, t7);
+    _mm512_store_pd(rec + 0, _mm512_shuffle_f64x2(u0, w0, 0x44));
+    _mm512_store_pd(rec + 8, _mm512_shuffle_f64x2(u1, w1, 0x44));
+    _mm512_store_pd(rec + 16, _mm512_shuffle_f64x2(u2, w2, 0x44));
+    _mm512_store_pd(rec + 24, _mm512_shuffle_f64x2(u3, w3, 0x44));
+    _mm512_store_pd(rec + 32, _mm512_shuffle_f64x2(u0, w0, 0xEE));
+    _mm512_store_pd(rec + 40, _mm512_shuffle_f64x2(u1, w1, 0xEE));
+    _mm512_store_pd(rec + 48, _mm512_shuffle_f64x2(u2, w2, 0xEE));
+    _mm512_store_pd(rec + 56, _mm512_shuffle_f64x2(u3, w3, 0xEE));
+#elif defined(__AVX2__)
+    for (int h = 0; h < 8; h += 4) {  // values 0..3, then 4..7: a 4 x 4 transpose each
+      const __m256d t0 = _mm256_unpacklo_pd(v[h], v[h + 1]), t1 = _mm256_unpackhi_pd(v[h], v[h + 1]);
+      const __m256d t2 = _mm256_unpacklo_pd(v[h + 2], v[h + 3]), t3 = _mm256_unpackhi_pd(v[h + 2], v[h + 3]);
+      _mm256_store_pd(rec + h, _mm256_permute2f128_pd(t0, t2, 0x20));
+      _mm256_store_pd(rec + 8 + h, _mm256_permute2f128_pd(t1, t3, 0x20));
+      _mm256_store_pd(rec + 16 + h, _mm256_permute2f128_pd(t0, t2, 0x31));
+      _mm256_store_pd(rec + 24 + h, _mm256_permute2f128_pd(t1, t3, 0x31));
+    }
+#else
+    static_assert(size == 2, "SSE: two lanes");
+    for (int j = 0; j < 8; j += 2) {
+      _mm_store_pd(rec + j, _mm_unpacklo_pd(v[j], v[j + 1]));
+      _mm_store_pd(rec + 8 + j, _mm_unpackhi_pd(v[j], v[j + 1]));
+    }
+#endif
+  }
   static Real iota(double start) {
     alignas(64) double l[size];
     for (std::size_t j = 0; j < size; ++j) l[j] = start + double(j);
@@ -121,6 +166,14 @@ void plane_walls_norot(const PlaneWallArgs& k, std::size_t b, std::size_t e) {
   plane_wall_loop<SimdLanes, false>(k, b, e);
 }
 
+void gather_pairs(const PairGatherArgs& g, std::size_t b, std::size_t e) {
+#if defined(__AVX2__)
+  gather_pairs_vector(g, b, e);
+#else
+  gather_pairs_scalar(g, b, e);  // SSE: two lanes do not beat the scalar loop here
+#endif
+}
+
 }  // namespace
 
 #define ASPERITY_STR2(a) #a
@@ -130,7 +183,7 @@ const KernelSet& ASPERITY_CAT(kernels_, ASPERITY_SIMD_ARCH)() {
   static const KernelSet set{ASPERITY_STR(ASPERITY_SIMD_ARCH), SimdLanes::size, &pair_rot,
                              &pair_norot, &bond_rot, &bond_norot,
                              &integrate_rot, &integrate_norot, &plane_walls_rot,
-                             &plane_walls_norot};
+                             &plane_walls_norot, &gather_pairs};
   return set;
 }
 

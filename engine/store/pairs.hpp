@@ -1,9 +1,9 @@
 // Pair store: the Verlet list of ball-ball pairs within the skin, touching or not, sorted by
 // (a, b) current indices with a < b. Per pair it keeps the contact normal and the shear force
 // (both are also the history for the next step), the normal force and the overlap; and, for the
-// gather, the pair's force on b and n x Fs, which the SIMD kernel computes eight pairs at a time
-// instead of the scalar gather computing them once per side (outputs of the step only: never
-// carried, copied or saved).
+// gather, one record per pair with the pair's force on b and n x Fs, which the SIMD kernel
+// computes eight pairs at a time instead of the scalar gather computing them once per side
+// (outputs of the step only: never carried, copied or saved).
 //
 // Sign convention (model.md 4): n points from a to b; fn, fs act on b; -(fn n + fs) acts on a.
 #pragma once
@@ -13,6 +13,8 @@
 #include "core/aligned.hpp"
 
 namespace asperity::detail {
+
+inline constexpr std::size_t kPairRecord = 8;  // doubles per pair in PairStore::out
 
 struct PairStore {
   std::size_t n = 0;       // real pairs
@@ -27,8 +29,11 @@ struct PairStore {
   // rest > 0 (World::install_bonds); it is forgotten with the shear force when U <= 0. The pair
   // kernel reads it only when State::rest_overlaps is set.
   AVec<double> rest;
-  AVec<double> fx, fy, fz;     // force on b: fn n + fs (on a: its negative)
-  AVec<double> cx, cy, cz;     // n x fs: the torque on either particle is -(R - U/2) times it
+  // The gather's record of pair k: out[kPairRecord k + j], j = 0..7: fx fy fz U cx cy cz 0, the
+  // force on b fn n + fs (on a: its negative), the overlap, and n x fs (the torque on either
+  // particle is -(R - U/2) times it). One 64-byte line per pair: the gather reaches a pair
+  // through the incidence list in one line instead of seven columns (perf/README.md).
+  AVec<double> out;
 
   void resize(std::size_t count) {
     n = count;
@@ -39,7 +44,7 @@ struct PairStore {
   }
   // The gather's columns are not saved: a store read from a checkpoint sizes them here.
   void size_outputs() {
-    for (auto* c : {&fx, &fy, &fz, &cx, &cy, &cz}) c->resize(padded);
+    out.resize(kPairRecord * padded);
   }
   // Padding entries: pair of two null particles, unit normal along x, no force.
   void fill_padding(std::int64_t null_a, std::int64_t null_b) {
@@ -48,8 +53,9 @@ struct PairStore {
       b[i] = null_b;
       nx[i] = 1;
       ny[i] = nz[i] = fsx[i] = fsy[i] = fsz[i] = fn[i] = rest[i] = 0;
-      fx[i] = fy[i] = fz[i] = cx[i] = cy[i] = cz[i] = 0;
       overlap[i] = -1;
+      for (std::size_t j = 0; j < kPairRecord; ++j) out[kPairRecord * i + j] = 0;
+      out[kPairRecord * i + 3] = -1;
     }
   }
   // Copy the history of pair o of `from` into slot k of this store.
