@@ -56,15 +56,14 @@ double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
     Lanes::store(k.mbn + i, s.mbn);
     Lanes::store(k.mbsx + i, s.mbsx); Lanes::store(k.mbsy + i, s.mbsy); Lanes::store(k.mbsz + i, s.mbsz);
     Lanes::store(k.broken + i, brk);
-    // For the gather (kernels/integrate.cpp), with the operations it would do per side.
+    // For the gather (kernels/integrate.cpp), with the operations it would do per side: the
+    // record fx fy fz U cx cy cz 0 mx my mz 0 of each bond (store/bonds.hpp).
     const T ftot = fn + s.fbn;
     const T sx = s.fsx + s.fbsx, sy = s.fsy + s.fbsy, sz = s.fsz + s.fbsz;
-    Lanes::store(k.fx + i, ftot * nx + sx); Lanes::store(k.fy + i, ftot * ny + sy);
-    Lanes::store(k.fz + i, ftot * nz + sz);
-    Lanes::store(k.cx + i, ny * sz - nz * sy); Lanes::store(k.cy + i, nz * sx - nx * sz);
-    Lanes::store(k.cz + i, nx * sy - ny * sx);
-    Lanes::store(k.mx + i, s.mbn * nx + s.mbsx); Lanes::store(k.my + i, s.mbn * ny + s.mbsy);
-    Lanes::store(k.mz + i, s.mbn * nz + s.mbsz);
+    const T record[12] = {ftot * nx + sx, ftot * ny + sy, ftot * nz + sz, U,
+                          ny * sz - nz * sy, nz * sx - nx * sz, nx * sy - ny * sx, T(0.0),
+                          s.mbn * nx + s.mbsx, s.mbn * ny + s.mbsy, s.mbn * nz + s.mbsz, T(0.0)};
+    Lanes::template store_records<12>(k.out + 12 * i, record);
   }
   return Lanes::sum(count);
 }

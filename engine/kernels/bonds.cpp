@@ -19,8 +19,7 @@ kernels::BondKernelArgs bond_kernel_args(State& s) {
           q.beam_radius.data(), q.nx.data(), q.ny.data(), q.nz.data(), q.fsx.data(),
           q.fsy.data(), q.fsz.data(), q.fn.data(), q.overlap.data(), q.fbn.data(), q.fbsx.data(),
           q.fbsy.data(), q.fbsz.data(), q.mbn.data(), q.mbsx.data(), q.mbsy.data(),
-          q.mbsz.data(), q.broken.data(), q.fx.data(), q.fy.data(), q.fz.data(), q.cx.data(),
-          q.cy.data(), q.cz.data(), q.mx.data(), q.my.data(), q.mz.data(), m.kn, m.ks,
+          q.mbsz.data(), q.broken.data(), q.out.data(), m.kn, m.ks,
           bm.beam_kn, bm.beam_ks, s.dt, bm.breakable ? bm.tensile_strength : 0.0, p.capacity,
           s.rest_overlaps ? q.rest.data() : nullptr};
 }

@@ -87,8 +87,9 @@ struct FloatLanes {
   static F32 load(const double* p) { return F32(*p); }
   static void store(double* p, const F32& v) { *p = double(v.v); }
   static double sum(const F32& v) { return double(v.v); }
+  template <int Width>
   static void store_records(double* rec, const F32* v) {
-    for (int j = 0; j < 8; ++j) rec[j] = double(v[j].v);
+    for (int j = 0; j < Width; ++j) rec[j] = double(v[j].v);
   }
 };
 
@@ -112,7 +113,7 @@ const KernelSet& float_study_kernels() {
   static const KernelSet set{"float", 1, &pair_rot, &pair_norot, &bond_rot, &bond_norot,
                              scalar_kernels().integrate, scalar_kernels().integrate_norot,
                              scalar_kernels().plane_walls, scalar_kernels().plane_walls_norot,
-                             scalar_kernels().gather_pairs};
+                             scalar_kernels().gather_pairs, scalar_kernels().gather_bonds};
   return set;
 }
 

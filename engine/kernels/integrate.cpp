@@ -9,44 +9,15 @@
 //   on a: -F,            torque (xc - xa) x (-F) = -(Ra - U/2) n x Fs
 // F and n x Fs (and a bond's beam moment) are computed by the SIMD pair and bond kernels, eight
 // pairs at a time; here only the lever arm, which differs per side, is applied. A pair's numbers
-// are one 64-byte record (store/pairs.hpp), which the pair gather kernel (gather_loop.hpp) reads
-// as two vectors; the bond and wall incidences follow in scalar code. The operations are those
-// the scalar gather did (so the results are bitwise the same).
+// are one 64-byte record (store/pairs.hpp), a bond's a 96-byte one (store/bonds.hpp), which the
+// gather kernels (gather_loop.hpp) read as 256-bit vectors; the wall and applied terms follow in
+// scalar passes. The operations are those the scalar gather did (so the results are bitwise the
+// same).
 #include <cmath>
 
 #include "state.hpp"
 
 namespace asperity::detail {
-
-namespace {
-// What the gather reads of the bond list: the incidence of each particle, and the kernel's force
-// on b, n x Fs, the overlap for the lever arm and the beam moment. Raw pointers held by value: the
-// stores to the force columns cannot make the compiler reload them (a vector's data pointer
-// reached through a reference can look aliased).
-struct BondColumns {
-  const std::int32_t* start;
-  const std::int64_t* entry;
-  const double *fx, *fy, *fz, *cx, *cy, *cz, *overlap, *mx, *my, *mz;
-};
-
-// Adds particle i's contributions from the bond list to (f, t), in the fixed order of its
-// incidence; the beam's moment acts on b, its negative on a.
-inline __attribute__((always_inline)) void add_bonds(const BondColumns& c, std::size_t i, double R,
-                                                     double& fx, double& fy, double& fz,
-                                                     double& tx, double& ty, double& tz) {
-  for (std::int32_t e = c.start[i]; e < c.start[i + 1]; ++e) {
-    const std::int64_t k = c.entry[e] >> 1;
-    const double sgn = (c.entry[e] & 1) ? 1.0 : -1.0;
-    fx += sgn * c.fx[k];
-    fy += sgn * c.fy[k];
-    fz += sgn * c.fz[k];
-    const double lever = R - 0.5 * c.overlap[k];
-    tx += sgn * c.mx[k] - lever * c.cx[k];
-    ty += sgn * c.my[k] - lever * c.cy[k];
-    tz += sgn * c.mz[k] - lever * c.cz[k];
-  }
-}
-}  // namespace
 
 StageLoop integrate_stage(State& s) {
   ParticleStore& p = s.p;
@@ -72,17 +43,20 @@ StageLoop integrate_stage(State& s) {
       applied ? p.az.data() : nullptr, nullptr, nullptr,
       s.dt, s.settings.local_damping, g.x, g.y, g.z};
 
-  // The pair sums of a range of particles (the kernel skips inert and idle ones, as below).
-  const auto gather_pairs = s.kernels->gather_pairs;
-  const kernels::PairGatherArgs pair_args{inc.start.data(), inc.entry.data(), q.out.data(),
-                                          p.radius.data(), p.inert.data(), idle, p.fx.data(),
-                                          p.fy.data(), p.fz.data(), p.tx.data(), p.ty.data(),
-                                          p.tz.data()};
-  // One particle's bond and wall contributions, added to its pair sums in the fixed order of its
-  // incidence lists. Raw pointers captured by value (see BondColumns).
-  const BondColumns bonds{binc.start.data(), binc.entry.data(), bq.fx.data(), bq.fy.data(),
-                            bq.fz.data(), bq.cx.data(), bq.cy.data(), bq.cz.data(),
-                            bq.overlap.data(), bq.mx.data(), bq.my.data(), bq.mz.data()};
+  // The pair sums and the bond terms of a range of particles (the kernels skip inert and idle
+  // ones, as below).
+  const auto gather_pairs = s.kernels->gather_pairs, gather_bonds = s.kernels->gather_bonds;
+  const kernels::GatherArgs pair_args{inc.start.data(), inc.entry.data(), q.out.data(),
+                                      p.radius.data(), p.inert.data(), idle, p.fx.data(),
+                                      p.fy.data(), p.fz.data(), p.tx.data(), p.ty.data(),
+                                      p.tz.data()};
+  kernels::GatherArgs bond_args = pair_args;
+  bond_args.start = binc.start.data();
+  bond_args.entry = binc.entry.data();
+  bond_args.records = bq.out.data();
+  // The wall and applied terms, added in passes after them. Raw pointers captured by value: the
+  // stores to the force columns cannot make the compiler reload them (a vector's data pointer
+  // reached through a reference can look aliased).
   const std::int32_t* wstart = wc.start.data();
   const double *wnx = wc.nx.data(), *wny = wc.ny.data(), *wnz = wc.nz.data(), *wsx = wc.fsx.data(),
                *wsy = wc.fsy.data(), *wsz = wc.fsz.data(), *wfn = wc.fn.data(), *wu = wc.overlap.data();
@@ -90,13 +64,6 @@ StageLoop integrate_stage(State& s) {
                *ay = applied ? p.ay.data() : nullptr, *az = applied ? p.az.data() : nullptr;
   double *Fx = p.fx.data(), *Fy = p.fy.data(), *Fz = p.fz.data(), *Tx = p.tx.data(), *Ty = p.ty.data(),
          *Tz = p.tz.data();
-  // Particle i's bond, wall and applied terms, added to its pair sums in that order.
-  auto add_bonds_to = [=](std::size_t i) __attribute__((always_inline)) {
-    double fx = Fx[i], fy = Fy[i], fz = Fz[i], tx = Tx[i], ty = Ty[i], tz = Tz[i];
-    add_bonds(bonds, i, radius[i], fx, fy, fz, tx, ty, tz);  // contact + parallel bond
-    Fx[i] = fx; Fy[i] = fy; Fz[i] = fz;
-    Tx[i] = tx; Ty[i] = ty; Tz[i] = tz;
-  };
   const std::int32_t* wparticle = wc.particle.data();
   auto add_wall = [=](std::int32_t k) __attribute__((always_inline)) {
     const std::size_t i = std::size_t(wparticle[k]);
@@ -119,7 +86,7 @@ StageLoop integrate_stage(State& s) {
   // The whole gather of one particle (the pair kernel's part included).
   auto gather = [=](std::size_t i) __attribute__((always_inline)) {
     gather_pairs(pair_args, i, i + 1);
-    if (any_bonds) add_bonds_to(i);
+    if (any_bonds) gather_bonds(bond_args, i, i + 1);
     for (std::int32_t k = wstart[i]; k < wstart[i + 1]; ++k) add_wall(k);
     if (applied) add_applied(i);
   };
@@ -151,9 +118,7 @@ StageLoop integrate_stage(State& s) {
     // The gather in passes over the block, each particle's terms in the order pairs, bonds,
     // walls, applied (as `gather`): inert and idle particles have none and are skipped.
     gather_pairs(pair_args, first, end);
-    if (any_bonds)
-      for (std::size_t i = first; i < end; ++i)
-        if (!inert[i] && !idle[i]) add_bonds_to(i);
+    if (any_bonds) gather_bonds(bond_args, first, end);
     for (std::int32_t k = wstart[first]; k < wstart[end]; ++k)
       if (!inert[wparticle[k]] && !idle[wparticle[k]]) add_wall(k);
     if (applied)

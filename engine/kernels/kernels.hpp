@@ -45,9 +45,9 @@ struct BondKernelArgs {
   double* fbn; double* fbsx; double* fbsy; double* fbsz;
   double* mbn; double* mbsx; double* mbsy; double* mbsz;
   double* broken;
-  double* fx; double* fy; double* fz;  // outputs for the gather (store/bonds.hpp)
-  double* cx; double* cy; double* cz;
-  double* mx; double* my; double* mz;
+  // Output for the gather (store/bonds.hpp): per bond the record fx fy fz U cx cy cz 0 mx my mz 0,
+  // twelve doubles from out + 12 k (32-byte aligned).
+  double* out;
   double kn, ks, beam_kn, beam_ks, dt, strength;
   std::size_t columns = 0;  // as PairKernelArgs::columns
   const double* rest = nullptr;  // rest overlaps of the contact bonds; null: all 0
@@ -79,22 +79,25 @@ struct PlaneWallArgs {
 
 using PlaneWallKernel = void (*)(const PlaneWallArgs&, std::size_t begin, std::size_t end);
 
-// Pair gather kernel (gather_loop.hpp): for each particle i in [begin, end) not marked in `inert`
-// or `idle` (either may be null), the sum over its pair incidences, in their order, of the force
-// and torque the pair records give it (store/pairs.hpp: record fx fy fz U cx cy cz 0; on b: +F,
-// on a: -F; on either: -(R - U/2) n x Fs), written to fx..tz[i]. The bonds, walls and applied
-// forces are added to these by the caller (kernels/integrate.cpp).
-struct PairGatherArgs {
+// Gather kernels (gather_loop.hpp), for each particle i in [begin, end) not marked in `inert` or
+// `idle` (either may be null), in the order of its incidences:
+// - pairs: the sum of the force and torque the pair records give it (store/pairs.hpp: record
+//   fx fy fz U cx cy cz 0; on b: +F, on a: -F; on either: -(R - U/2) n x Fs), written to
+//   fx..tz[i];
+// - bonds: the same from the bond records (store/bonds.hpp), plus the beam moment (+M on b, -M on
+//   a), added to fx..tz[i].
+// The walls and applied forces are added by the caller (kernels/integrate.cpp).
+struct GatherArgs {
   const std::int32_t* start;  // incidence CSR (store/pairs.hpp, Incidence)
-  const std::int64_t* entry;  // (pair << 1) | (particle is b)
-  const double* records;      // 8 doubles per pair
+  const std::int64_t* entry;  // (pair or bond << 1) | (particle is b)
+  const double* records;      // 8 doubles per pair, 12 per bond
   const double* radius;
   const std::uint8_t* inert; const std::uint8_t* idle;
   double* fx; double* fy; double* fz;
   double* tx; double* ty; double* tz;
 };
 
-using PairGatherKernel = void (*)(const PairGatherArgs&, std::size_t begin, std::size_t end);
+using GatherKernel = void (*)(const GatherArgs&, std::size_t begin, std::size_t end);
 
 // Integrate kernel (integrate_loop.hpp): particles [begin, end), begin a multiple of kMaxLanes and
 // end padded up to one (the padding particles have free = 0). `free` and `spin` are 0/1 masks
@@ -136,7 +139,8 @@ struct KernelSet {
   IntegrateKernel integrate_norot;  // no particle can rotate: w and torques are not read
   PlaneWallKernel plane_walls;       // with rotation
   PlaneWallKernel plane_walls_norot;
-  PairGatherKernel gather_pairs;
+  GatherKernel gather_pairs;
+  GatherKernel gather_bonds;
 };
 
 const KernelSet& scalar_kernels();

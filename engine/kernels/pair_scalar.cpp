@@ -25,8 +25,9 @@ struct ScalarLanes {
   static void store_u(double* p, double v) { *p = v; }
   static std::int64_t index32(const std::int32_t* p) { return *p; }
   static double sum(double v) { return v; }
+  template <int Width>
   static void store_records(double* rec, const double* v) {
-    for (int j = 0; j < 8; ++j) rec[j] = v[j];
+    for (int j = 0; j < Width; ++j) rec[j] = v[j];
   }
   static double iota(double start) { return start; }
   static double lane(double v, std::size_t) { return v; }
@@ -59,8 +60,11 @@ void plane_walls_norot(const PlaneWallArgs& k, std::size_t b, std::size_t e) {
   plane_wall_loop<ScalarLanes, false>(k, b, e);
 }
 
-void gather_pairs(const PairGatherArgs& g, std::size_t b, std::size_t e) {
+void gather_pairs(const GatherArgs& g, std::size_t b, std::size_t e) {
   gather_pairs_scalar(g, b, e);
+}
+void gather_bonds(const GatherArgs& g, std::size_t b, std::size_t e) {
+  gather_bonds_scalar(g, b, e);
 }
 
 }  // namespace
@@ -68,7 +72,7 @@ void gather_pairs(const PairGatherArgs& g, std::size_t b, std::size_t e) {
 const KernelSet& scalar_kernels() {
   static const KernelSet set{"scalar", 1, &pair_rot, &pair_norot, &bond_rot, &bond_norot,
                              &integrate_rot, &integrate_norot, &plane_walls_rot,
-                             &plane_walls_norot, &gather_pairs};
+                             &plane_walls_norot, &gather_pairs, &gather_bonds};
   return set;
 }
 

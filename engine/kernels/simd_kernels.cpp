@@ -83,47 +83,56 @@ struct SimdLanes {
 #endif
   }
   static double sum(const Real& v) { return xsimd::hadd(v); }
-  // Records (store/pairs.hpp): v[j] holds value j of the batch's pairs; pair p's eight values go
-  // to rec[8 p .. 8 p + 7]. A transpose of eight rows, then one aligned full-line store per pair
-  // (or two half-line stores on AVX2, four quarters on SSE).
+  // Records (store/pairs.hpp, store/bonds.hpp): v[j] holds value j of the batch's pairs or bonds;
+  // the Width values of item p go to rec[Width p .. Width p + Width - 1]. A transpose of the rows,
+  // then full-line stores per item (half lines on AVX2, quarters on SSE). rec is 64-byte
+  // aligned for Width 8, 32-byte aligned for Width 12.
+  template <int Width>
   static void store_records(double* rec, const Real* v) {
+    static_assert(Width == 8 || Width == 12, "records of 8 or 12 values");
 #if defined(__AVX512F__)
-    // Rows of pairs -> pairs of two-element runs -> half records -> records.
+    // Rows of items -> pairs of two-element runs -> half records -> records.
     const __m512d t0 = _mm512_unpacklo_pd(v[0], v[1]), t1 = _mm512_unpackhi_pd(v[0], v[1]);
     const __m512d t2 = _mm512_unpacklo_pd(v[2], v[3]), t3 = _mm512_unpackhi_pd(v[2], v[3]);
     const __m512d t4 = _mm512_unpacklo_pd(v[4], v[5]), t5 = _mm512_unpackhi_pd(v[4], v[5]);
     const __m512d t6 = _mm512_unpacklo_pd(v[6], v[7]), t7 = _mm512_unpackhi_pd(v[6], v[7]);
-    // t0 = v0_0 v1_0 v0_2 v1_2 v0_4 v1_4 v0_6 v1_6 (vj_p: value j of pair p); t1 the odd pairs.
+    // t0 = v0_0 v1_0 v0_2 v1_2 v0_4 v1_4 v0_6 v1_6 (vj_p: value j of item p); t1 the odd items.
     const __m512i lo = _mm512_setr_epi64(0, 1, 8, 9, 4, 5, 12, 13);
     const __m512i hi = _mm512_setr_epi64(2, 3, 10, 11, 6, 7, 14, 15);
-    // u0 = values 0..3 of pairs 0 and 4, u1 of pairs 1 and 5, u2 of 2 and 6, u3 of 3 and 7; w*
+    // u0 = values 0..3 of items 0 and 4, u1 of items 1 and 5, u2 of 2 and 6, u3 of 3 and 7; w*
     // the same for values 4..7.
-    const __m512d u0 = _mm512_permutex2var_pd(t0, lo, t2), u2 = _mm512_permutex2var_pd(t0, hi, t2);
-    const __m512d u1 = _mm512_permutex2var_pd(t1, lo, t3), u3 = _mm512_permutex2var_pd(t1, hi, t3);
-    const __m512d w0 = _mm512_permutex2var_pd(t4, lo, t6), w2 = _mm512_permutex2var_pd(t4, hi, t6);
-    const __m512d w1 = _mm512_permutex2var_pd(t5, lo, t7), w3 = _mm512_permutex2var_pd(t5, hi, t7);
-    _mm512_store_pd(rec + 0, _mm512_shuffle_f64x2(u0, w0, 0x44));
-    _mm512_store_pd(rec + 8, _mm512_shuffle_f64x2(u1, w1, 0x44));
-    _mm512_store_pd(rec + 16, _mm512_shuffle_f64x2(u2, w2, 0x44));
-    _mm512_store_pd(rec + 24, _mm512_shuffle_f64x2(u3, w3, 0x44));
-    _mm512_store_pd(rec + 32, _mm512_shuffle_f64x2(u0, w0, 0xEE));
-    _mm512_store_pd(rec + 40, _mm512_shuffle_f64x2(u1, w1, 0xEE));
-    _mm512_store_pd(rec + 48, _mm512_shuffle_f64x2(u2, w2, 0xEE));
-    _mm512_store_pd(rec + 56, _mm512_shuffle_f64x2(u3, w3, 0xEE));
+    const __m512d u[4] = {_mm512_permutex2var_pd(t0, lo, t2), _mm512_permutex2var_pd(t1, lo, t3),
+                          _mm512_permutex2var_pd(t0, hi, t2), _mm512_permutex2var_pd(t1, hi, t3)};
+    const __m512d w[4] = {_mm512_permutex2var_pd(t4, lo, t6), _mm512_permutex2var_pd(t5, lo, t7),
+                          _mm512_permutex2var_pd(t4, hi, t6), _mm512_permutex2var_pd(t5, hi, t7)};
+    for (int p = 0; p < 4; ++p) {
+      _mm512_storeu_pd(rec + Width * p, _mm512_shuffle_f64x2(u[p], w[p], 0x44));
+      _mm512_storeu_pd(rec + Width * (p + 4), _mm512_shuffle_f64x2(u[p], w[p], 0xEE));
+    }
+    if constexpr (Width == 12) {  // values 8..11: quarter lines
+      const __m512d s0 = _mm512_unpacklo_pd(v[8], v[9]), s1 = _mm512_unpackhi_pd(v[8], v[9]);
+      const __m512d s2 = _mm512_unpacklo_pd(v[10], v[11]), s3 = _mm512_unpackhi_pd(v[10], v[11]);
+      const __m512d x[4] = {_mm512_permutex2var_pd(s0, lo, s2), _mm512_permutex2var_pd(s1, lo, s3),
+                            _mm512_permutex2var_pd(s0, hi, s2), _mm512_permutex2var_pd(s1, hi, s3)};
+      for (int p = 0; p < 4; ++p) {
+        _mm256_store_pd(rec + Width * p + 8, _mm512_castpd512_pd256(x[p]));
+        _mm256_store_pd(rec + Width * (p + 4) + 8, _mm512_extractf64x4_pd(x[p], 1));
+      }
+    }
 #elif defined(__AVX2__)
-    for (int h = 0; h < 8; h += 4) {  // values 0..3, then 4..7: a 4 x 4 transpose each
+    for (int h = 0; h < Width; h += 4) {  // values h..h+3: a 4 x 4 transpose each
       const __m256d t0 = _mm256_unpacklo_pd(v[h], v[h + 1]), t1 = _mm256_unpackhi_pd(v[h], v[h + 1]);
       const __m256d t2 = _mm256_unpacklo_pd(v[h + 2], v[h + 3]), t3 = _mm256_unpackhi_pd(v[h + 2], v[h + 3]);
       _mm256_store_pd(rec + h, _mm256_permute2f128_pd(t0, t2, 0x20));
-      _mm256_store_pd(rec + 8 + h, _mm256_permute2f128_pd(t1, t3, 0x20));
-      _mm256_store_pd(rec + 16 + h, _mm256_permute2f128_pd(t0, t2, 0x31));
-      _mm256_store_pd(rec + 24 + h, _mm256_permute2f128_pd(t1, t3, 0x31));
+      _mm256_store_pd(rec + Width + h, _mm256_permute2f128_pd(t1, t3, 0x20));
+      _mm256_store_pd(rec + 2 * Width + h, _mm256_permute2f128_pd(t0, t2, 0x31));
+      _mm256_store_pd(rec + 3 * Width + h, _mm256_permute2f128_pd(t1, t3, 0x31));
     }
 #else
     static_assert(size == 2, "SSE: two lanes");
-    for (int j = 0; j < 8; j += 2) {
+    for (int j = 0; j < Width; j += 2) {
       _mm_store_pd(rec + j, _mm_unpacklo_pd(v[j], v[j + 1]));
-      _mm_store_pd(rec + 8 + j, _mm_unpackhi_pd(v[j], v[j + 1]));
+      _mm_store_pd(rec + Width + j, _mm_unpackhi_pd(v[j], v[j + 1]));
     }
 #endif
   }
@@ -166,11 +175,18 @@ void plane_walls_norot(const PlaneWallArgs& k, std::size_t b, std::size_t e) {
   plane_wall_loop<SimdLanes, false>(k, b, e);
 }
 
-void gather_pairs(const PairGatherArgs& g, std::size_t b, std::size_t e) {
+void gather_pairs(const GatherArgs& g, std::size_t b, std::size_t e) {
 #if defined(__AVX2__)
   gather_pairs_vector(g, b, e);
 #else
   gather_pairs_scalar(g, b, e);  // SSE: two lanes do not beat the scalar loop here
+#endif
+}
+void gather_bonds(const GatherArgs& g, std::size_t b, std::size_t e) {
+#if defined(__AVX2__)
+  gather_bonds_vector(g, b, e);
+#else
+  gather_bonds_scalar(g, b, e);
 #endif
 }
 
@@ -183,7 +199,7 @@ const KernelSet& ASPERITY_CAT(kernels_, ASPERITY_SIMD_ARCH)() {
   static const KernelSet set{ASPERITY_STR(ASPERITY_SIMD_ARCH), SimdLanes::size, &pair_rot,
                              &pair_norot, &bond_rot, &bond_norot,
                              &integrate_rot, &integrate_norot, &plane_walls_rot,
-                             &plane_walls_norot, &gather_pairs};
+                             &plane_walls_norot, &gather_pairs, &gather_bonds};
   return set;
 }
 

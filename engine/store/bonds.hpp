@@ -14,6 +14,8 @@
 
 namespace asperity::detail {
 
+inline constexpr std::size_t kBondRecord = 12;  // doubles per bond in BondStore::out
+
 struct BondStore {
   std::size_t n = 0;
   std::size_t padded = 0;
@@ -30,10 +32,11 @@ struct BondStore {
   AVec<double> mbn;                       // twisting moment (along n)
   AVec<double> mbsx, mbsy, mbsz;          // bending moment
   AVec<double> broken;                    // 1 when the criterion was met this step
-  // For the gather, computed by the SIMD kernel (outputs of the step only, like PairStore's):
-  AVec<double> fx, fy, fz;                // force on b: (fn + fbn) n + fs + fbs
-  AVec<double> cx, cy, cz;                // n x (fs + fbs): torque per lever arm, negated
-  AVec<double> mx, my, mz;                // beam moment on b: mbn n + mbs (on a: its negative)
+  // For the gather, computed by the SIMD kernel (outputs of the step only, like PairStore's): the
+  // record of bond k is out[kBondRecord k + j], j = 0..11: fx fy fz U cx cy cz 0 mx my mz 0, the
+  // force on b (fn + fbn) n + fs + fbs, the overlap, n x (fs + fbs) (torque per lever arm,
+  // negated) and the beam moment on b mbn n + mbs (on a: its negative).
+  AVec<double> out;
   BondMaterial material;
   bool any = false;                       // a material was set by a first installation
 
@@ -48,7 +51,7 @@ struct BondStore {
   }
   // The gather's columns are not saved: a store read from a checkpoint sizes them here.
   void size_outputs() {
-    for (auto* c : {&fx, &fy, &fz, &cx, &cy, &cz, &mx, &my, &mz}) c->resize(padded);
+    out.resize(kBondRecord * padded);
   }
   void fill_padding(std::int64_t null_a, std::int64_t null_b) {
     for (std::size_t i = n; i < padded; ++i) {
@@ -58,7 +61,7 @@ struct BondStore {
       nx[i] = 1;
       ny[i] = nz[i] = fsx[i] = fsy[i] = fsz[i] = fn[i] = overlap[i] = rest[i] = fbn[i] = 0;
       fbsx[i] = fbsy[i] = fbsz[i] = mbn[i] = mbsx[i] = mbsy[i] = mbsz[i] = broken[i] = 0;
-      fx[i] = fy[i] = fz[i] = cx[i] = cy[i] = cz[i] = mx[i] = my[i] = mz[i] = 0;
+      for (std::size_t j = 0; j < kBondRecord; ++j) out[kBondRecord * i + j] = 0;
     }
   }
   // Copy bond o of `from` into slot k of this store.

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -390,35 +391,42 @@ TEST(Determinism, SimdPlaneWallKernelEqualsTheScalarReferenceBitwise) {
   }
 }
 
-// The pair gather kernel: random pairs and records, some particles inert or idle (never written),
-// some with no pairs; every architecture's sums equal the scalar reference's bit for bit, and the
-// reference equals a direct sum of the law's terms.
-TEST(Determinism, SimdPairGatherEqualsTheScalarReferenceBitwise) {
-  const std::size_t n = 777, pairs = 2500;
+// The gather kernels: random pairs and bonds with random records, some particles inert or idle
+// (never written), some with no pairs; the pairs' sums and then the bonds' terms, as the stage
+// runs them. Every architecture equals the scalar references bit for bit, and they equal the
+// direct sums of model.md 4 and 5 in incidence order.
+TEST(Determinism, SimdGatherEqualsTheScalarReferenceBitwise) {
+  const std::size_t n = 777, count = 2500;
   std::mt19937_64 rng(17);
   std::uniform_real_distribution<double> u(-1, 1);
-  std::vector<std::int64_t> a(pairs), b(pairs);
-  for (std::size_t k = 0; k < pairs; ++k) {
-    std::int64_t i = std::int64_t(rng() % (n - 1)), j = std::int64_t(rng() % n);
-    if (j == i) j = i + 1;
-    a[k] = std::min(i, j);
-    b[k] = std::max(i, j);
-  }
-  std::vector<std::size_t> order(pairs);
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
-    return a[x] != a[y] ? a[x] < a[y] : b[x] < b[y];
-  });
-  std::vector<std::int64_t> sa(pairs), sb(pairs);
-  for (std::size_t k = 0; k < pairs; ++k) sa[k] = a[order[k]], sb[k] = b[order[k]];
-  detail::Incidence inc;
-  detail::build_incidence(n, sa.data(), sb.data(), pairs, inc);
-  std::vector<double, AlignedAllocator<double>> records(8 * pairs);
-  for (std::size_t k = 0; k < pairs; ++k) {
-    for (int j = 0; j < 7; ++j) records[8 * k + j] = u(rng);
-    records[8 * k + 3] = 1e-5 * u(rng);  // the overlap
-    records[8 * k + 7] = 0;
-  }
+  // A sorted list of `count` random (a, b), a < b, its incidence and random records.
+  struct List {
+    std::vector<std::int64_t> a, b;
+    detail::Incidence inc;
+    std::vector<double, AlignedAllocator<double>> records;
+  };
+  auto make = [&](std::size_t width) {
+    List l;
+    std::vector<std::pair<std::int64_t, std::int64_t>> ab(count);
+    for (auto& [i, j] : ab) {
+      i = std::int64_t(rng() % (n - 1));
+      j = std::int64_t(rng() % n);
+      if (j == i) j = i + 1;
+      if (j < i) std::swap(i, j);
+    }
+    std::sort(ab.begin(), ab.end());
+    for (auto [i, j] : ab) l.a.push_back(i), l.b.push_back(j);
+    detail::build_incidence(n, l.a.data(), l.b.data(), count, l.inc);
+    l.records.resize(width * count);
+    for (std::size_t k = 0; k < count; ++k) {
+      for (std::size_t j = 0; j < width; ++j) l.records[width * k + j] = u(rng);
+      l.records[width * k + 3] = 1e-5 * u(rng);  // the overlap
+      l.records[width * k + 7] = 0;
+      if (width == 12) l.records[width * k + 11] = 0;
+    }
+    return l;
+  };
+  const List pairs = make(8), bonds = make(12);
   std::vector<double> radius(n);
   std::vector<std::uint8_t> inert(n, 0), idle(n, 0);
   for (std::size_t i = 0; i < n; ++i) {
@@ -426,47 +434,54 @@ TEST(Determinism, SimdPairGatherEqualsTheScalarReferenceBitwise) {
     inert[i] = i % 11 == 0;
     idle[i] = i % 13 == 0;
   }
-  struct Out {
-    std::vector<double> f[6];
-    explicit Out(std::size_t n) {
-      for (auto& c : f) c.assign(n, -7.0);
+  using Columns = std::array<std::vector<double>, 6>;  // fx fy fz tx ty tz
+  auto run = [&](const kernels::KernelSet& ks) {
+    Columns o;
+    for (auto& c : o) c.assign(n, -7.0);
+    kernels::GatherArgs g{pairs.inc.start.data(), pairs.inc.entry.data(), pairs.records.data(),
+                          radius.data(), inert.data(), idle.data(), o[0].data(), o[1].data(),
+                          o[2].data(), o[3].data(), o[4].data(), o[5].data()};
+    kernels::GatherArgs gb = g;
+    gb.start = bonds.inc.start.data();
+    gb.entry = bonds.inc.entry.data();
+    gb.records = bonds.records.data();
+    for (auto [first, end] : {std::pair<std::size_t, std::size_t>{0, 400}, {400, n}}) {  // two blocks
+      ks.gather_pairs(g, first, end);
+      ks.gather_bonds(gb, first, end);
     }
-  };
-  auto run = [&](kernels::PairGatherKernel kernel) {
-    Out o(n);
-    const kernels::PairGatherArgs g{inc.start.data(), inc.entry.data(), records.data(),
-                                    radius.data(), inert.data(), idle.data(), o.f[0].data(),
-                                    o.f[1].data(), o.f[2].data(), o.f[3].data(), o.f[4].data(),
-                                    o.f[5].data()};
-    kernel(g, 0, 400);  // two calls, as the stage calls it per block
-    kernel(g, 400, n);
     return o;
   };
-  const Out ref = run(kernels::scalar_kernels().gather_pairs);
-  // The reference against the terms of model.md 4, summed in incidence order.
+  const Columns ref = run(kernels::scalar_kernels());
   std::size_t checked = 0;
   for (std::size_t i = 0; i < n; ++i) {
     if (inert[i] || idle[i]) {
-      EXPECT_EQ(ref.f[0][i], -7.0) << "a skipped particle is not written";
+      EXPECT_EQ(ref[0][i], -7.0) << "a skipped particle is not written";
       continue;
     }
     double fx = 0, tz = 0;
-    for (std::int32_t e = inc.start[i]; e < inc.start[i + 1]; ++e) {
-      const std::size_t k = std::size_t(inc.entry[e] >> 1);
-      const bool is_b = inc.entry[e] & 1;
-      EXPECT_EQ(is_b ? sb[k] : sa[k], std::int64_t(i));
-      fx += (is_b ? 1.0 : -1.0) * records[8 * k];
-      tz -= (radius[i] - 0.5 * records[8 * k + 3]) * records[8 * k + 6];
+    for (const List* l : {&pairs, &bonds}) {
+      const std::size_t width = l == &pairs ? 8 : 12;
+      for (std::int32_t e = l->inc.start[i]; e < l->inc.start[i + 1]; ++e) {
+        const std::size_t k = std::size_t(l->inc.entry[e] >> 1);
+        const bool is_b = l->inc.entry[e] & 1;
+        EXPECT_EQ(is_b ? l->b[k] : l->a[k], std::int64_t(i));
+        const double* r = &l->records[width * k];
+        const double sgn = is_b ? 1.0 : -1.0;
+        fx += sgn * r[0];
+        const double lever = radius[i] - 0.5 * r[3];
+        if (width == 8) tz -= lever * r[6];
+        else tz += sgn * r[10] - lever * r[6];  // the beam moment acts on b, its negative on a
+      }
     }
-    EXPECT_EQ(ref.f[0][i], fx) << i;
-    EXPECT_EQ(ref.f[5][i], tz) << i;
-    checked += inc.start[i + 1] > inc.start[i];
+    EXPECT_EQ(ref[0][i], fx) << i;
+    EXPECT_EQ(ref[5][i], tz) << i;
+    checked += bonds.inc.start[i + 1] > bonds.inc.start[i] && pairs.inc.start[i + 1] > pairs.inc.start[i];
   }
   EXPECT_GT(checked, n / 2);
   for (const auto& arch : available_simd_architectures()) {
-    const Out got = run(kernels::select_kernels(arch).gather_pairs);
+    const Columns got = run(kernels::select_kernels(arch));
     for (int c = 0; c < 6; ++c)
-      EXPECT_EQ(0, std::memcmp(ref.f[c].data(), got.f[c].data(), n * sizeof(double)))
+      EXPECT_EQ(0, std::memcmp(ref[c].data(), got[c].data(), n * sizeof(double)))
           << arch << " column " << c;
   }
 }
