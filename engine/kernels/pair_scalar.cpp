@@ -61,10 +61,10 @@ void plane_walls_norot(const PlaneWallArgs& k, std::size_t b, std::size_t e) {
 }
 
 void gather_pairs(const GatherArgs& g, std::size_t b, std::size_t e) {
-  gather_pairs_scalar(g, b, e);
+  gather_scalar<false>(g, b, e);
 }
 void gather_bonds(const GatherArgs& g, std::size_t b, std::size_t e) {
-  gather_bonds_scalar(g, b, e);
+  gather_scalar<true>(g, b, e);
 }
 
 }  // namespace

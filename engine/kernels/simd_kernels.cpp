@@ -177,16 +177,16 @@ void plane_walls_norot(const PlaneWallArgs& k, std::size_t b, std::size_t e) {
 
 void gather_pairs(const GatherArgs& g, std::size_t b, std::size_t e) {
 #if defined(__AVX2__)
-  gather_pairs_vector(g, b, e);
+  gather_vector<false>(g, b, e);
 #else
-  gather_pairs_scalar(g, b, e);  // SSE: two lanes do not beat the scalar loop here
+  gather_scalar<false>(g, b, e);  // SSE: two lanes do not beat the scalar loop here
 #endif
 }
 void gather_bonds(const GatherArgs& g, std::size_t b, std::size_t e) {
 #if defined(__AVX2__)
-  gather_bonds_vector(g, b, e);
+  gather_vector<true>(g, b, e);
 #else
-  gather_bonds_scalar(g, b, e);
+  gather_scalar<true>(g, b, e);
 #endif
 }
 
