@@ -18,7 +18,6 @@
 #include <cmath>
 
 #include "kernels/bond_loop.hpp"
-#include "kernels/integrate_loop.hpp"
 #include "kernels/pair_loop.hpp"
 
 namespace asperity::kernels {
@@ -93,24 +92,12 @@ struct FloatLanes {
   }
 };
 
-double pair_rot(const PairKernelArgs& k, std::size_t b, std::size_t e) {
-  return pair_loop<FloatLanes, true>(k, b, e);
-}
-double pair_norot(const PairKernelArgs& k, std::size_t b, std::size_t e) {
-  return pair_loop<FloatLanes, false>(k, b, e);
-}
-double bond_rot(const BondKernelArgs& k, std::size_t b, std::size_t e) {
-  return bond_loop<FloatLanes, true>(k, b, e);
-}
-double bond_norot(const BondKernelArgs& k, std::size_t b, std::size_t e) {
-  return bond_loop<FloatLanes, false>(k, b, e);
-}
-
 }  // namespace
 
 const KernelSet& float_study_kernels() {
   // The integration, the plane walls and the gather are the scalar reference's, in double.
-  static const KernelSet set{"float", 1, &pair_rot, &pair_norot, &bond_rot, &bond_norot,
+  static const KernelSet set{"float", 1, &pair_loop<FloatLanes, true>, &pair_loop<FloatLanes, false>,
+                             &bond_loop<FloatLanes, true>, &bond_loop<FloatLanes, false>,
                              scalar_kernels().integrate, scalar_kernels().integrate_norot,
                              scalar_kernels().plane_walls, scalar_kernels().plane_walls_norot,
                              scalar_kernels().gather_pairs, scalar_kernels().gather_bonds};

@@ -1,10 +1,7 @@
 // Scalar reference of the pair kernel: one pair at a time, plain doubles. It is the definition
 // the SIMD kernels are tested against, and what a build without SIMD runs.
-#include "kernels/bond_loop.hpp"
 #include "kernels/gather_loop.hpp"
-#include "kernels/integrate_loop.hpp"
-#include "kernels/pair_loop.hpp"
-#include "kernels/wall_loop.hpp"
+#include "kernels/kernel_set.hpp"
 
 namespace asperity::kernels {
 namespace {
@@ -33,46 +30,11 @@ struct ScalarLanes {
   static double lane(double v, std::size_t) { return v; }
 };
 
-double pair_rot(const PairKernelArgs& k, std::size_t b, std::size_t e) {
-  return pair_loop<ScalarLanes, true>(k, b, e);
-}
-double pair_norot(const PairKernelArgs& k, std::size_t b, std::size_t e) {
-  return pair_loop<ScalarLanes, false>(k, b, e);
-}
-double bond_rot(const BondKernelArgs& k, std::size_t b, std::size_t e) {
-  return bond_loop<ScalarLanes, true>(k, b, e);
-}
-double bond_norot(const BondKernelArgs& k, std::size_t b, std::size_t e) {
-  return bond_loop<ScalarLanes, false>(k, b, e);
-}
-
-void integrate_rot(const IntegrateArgs& k, std::size_t b, std::size_t e, IntegrateSums& out) {
-  integrate_loop<ScalarLanes, true>(k, b, e, out);
-}
-void integrate_norot(const IntegrateArgs& k, std::size_t b, std::size_t e, IntegrateSums& out) {
-  integrate_loop<ScalarLanes, false>(k, b, e, out);
-}
-
-void plane_walls_rot(const PlaneWallArgs& k, std::size_t b, std::size_t e) {
-  plane_wall_loop<ScalarLanes, true>(k, b, e);
-}
-void plane_walls_norot(const PlaneWallArgs& k, std::size_t b, std::size_t e) {
-  plane_wall_loop<ScalarLanes, false>(k, b, e);
-}
-
-void gather_pairs(const GatherArgs& g, std::size_t b, std::size_t e) {
-  gather_scalar<false>(g, b, e);
-}
-void gather_bonds(const GatherArgs& g, std::size_t b, std::size_t e) {
-  gather_scalar<true>(g, b, e);
-}
-
 }  // namespace
 
 const KernelSet& scalar_kernels() {
-  static const KernelSet set{"scalar", 1, &pair_rot, &pair_norot, &bond_rot, &bond_norot,
-                             &integrate_rot, &integrate_norot, &plane_walls_rot,
-                             &plane_walls_norot, &gather_pairs, &gather_bonds};
+  static const KernelSet set =
+      loop_kernels<ScalarLanes>("scalar", &gather_scalar<false>, &gather_scalar<true>);
   return set;
 }
 

@@ -6,11 +6,8 @@
 
 #include <xsimd/xsimd.hpp>
 
-#include "kernels/bond_loop.hpp"
 #include "kernels/gather_loop.hpp"
-#include "kernels/integrate_loop.hpp"
-#include "kernels/pair_loop.hpp"
-#include "kernels/wall_loop.hpp"
+#include "kernels/kernel_set.hpp"
 
 #define ASPERITY_CAT2(a, b) a##b
 #define ASPERITY_CAT(a, b) ASPERITY_CAT2(a, b)
@@ -148,47 +145,11 @@ struct SimdLanes {
   }
 };
 
-double pair_rot(const PairKernelArgs& k, std::size_t b, std::size_t e) {
-  return pair_loop<SimdLanes, true>(k, b, e);
-}
-double pair_norot(const PairKernelArgs& k, std::size_t b, std::size_t e) {
-  return pair_loop<SimdLanes, false>(k, b, e);
-}
-double bond_rot(const BondKernelArgs& k, std::size_t b, std::size_t e) {
-  return bond_loop<SimdLanes, true>(k, b, e);
-}
-double bond_norot(const BondKernelArgs& k, std::size_t b, std::size_t e) {
-  return bond_loop<SimdLanes, false>(k, b, e);
-}
-
-void integrate_rot(const IntegrateArgs& k, std::size_t b, std::size_t e, IntegrateSums& out) {
-  integrate_loop<SimdLanes, true>(k, b, e, out);
-}
-void integrate_norot(const IntegrateArgs& k, std::size_t b, std::size_t e, IntegrateSums& out) {
-  integrate_loop<SimdLanes, false>(k, b, e, out);
-}
-
-void plane_walls_rot(const PlaneWallArgs& k, std::size_t b, std::size_t e) {
-  plane_wall_loop<SimdLanes, true>(k, b, e);
-}
-void plane_walls_norot(const PlaneWallArgs& k, std::size_t b, std::size_t e) {
-  plane_wall_loop<SimdLanes, false>(k, b, e);
-}
-
-void gather_pairs(const GatherArgs& g, std::size_t b, std::size_t e) {
 #if defined(__AVX2__)
-  gather_vector<false>(g, b, e);
-#else
-  gather_scalar<false>(g, b, e);  // SSE: two lanes do not beat the scalar loop here
+constexpr GatherKernel gather_pairs = &gather_vector<false>, gather_bonds = &gather_vector<true>;
+#else  // SSE: two lanes do not beat the scalar loop here
+constexpr GatherKernel gather_pairs = &gather_scalar<false>, gather_bonds = &gather_scalar<true>;
 #endif
-}
-void gather_bonds(const GatherArgs& g, std::size_t b, std::size_t e) {
-#if defined(__AVX2__)
-  gather_vector<true>(g, b, e);
-#else
-  gather_scalar<true>(g, b, e);
-#endif
-}
 
 }  // namespace
 
@@ -196,10 +157,8 @@ void gather_bonds(const GatherArgs& g, std::size_t b, std::size_t e) {
 #define ASPERITY_STR(a) ASPERITY_STR2(a)
 
 const KernelSet& ASPERITY_CAT(kernels_, ASPERITY_SIMD_ARCH)() {
-  static const KernelSet set{ASPERITY_STR(ASPERITY_SIMD_ARCH), SimdLanes::size, &pair_rot,
-                             &pair_norot, &bond_rot, &bond_norot,
-                             &integrate_rot, &integrate_norot, &plane_walls_rot,
-                             &plane_walls_norot, &gather_pairs, &gather_bonds};
+  static const KernelSet set =
+      loop_kernels<SimdLanes>(ASPERITY_STR(ASPERITY_SIMD_ARCH), gather_pairs, gather_bonds);
   return set;
 }
 
