@@ -2,6 +2,7 @@
 // bookkeeping, the breaks: an event each, the released strain energy, the contact a broken bond
 // leaves behind, compaction of the list and the rotation locks.
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "kernels/bond_law.hpp"
@@ -117,9 +118,9 @@ StageLoop bond_stage(State& s) {
   if (spin) {
     const ParticleStore& p = s.p;
     spin = false;
+    auto bits = [](double w) { return std::bit_cast<std::uint64_t>(w); };  // 0: exactly +0
     for (const std::int32_t i : s.bonded_particles)
-      if (p.wx[i] != 0 || p.wy[i] != 0 || p.wz[i] != 0 || std::signbit(p.wx[i]) ||
-          std::signbit(p.wy[i]) || std::signbit(p.wz[i])) {
+      if (bits(p.wx[i]) | bits(p.wy[i]) | bits(p.wz[i])) {
         spin = true;
         break;
       }

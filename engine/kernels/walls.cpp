@@ -176,15 +176,23 @@ StageLoop wall_stage(State& s) {
   sums->slip.assign(st.blocks, 0.0);
   sums->work.assign(st.blocks, 0.0);
   sums->force.assign(st.blocks * nw, Vec3{});
-  for (const Wall& w : s.walls.walls) {
-    const Vec3 point = w.point + w.displacement;
+  // The wall columns, only when there are contacts to read them: a joint removes its walls after
+  // packing (they stay listed), and its closure and shear then build no table per step.
+  if (wc.n > 0) {
     Sums& t = *sums;
-    t.px.push_back(point.x); t.py.push_back(point.y); t.pz.push_back(point.z);
-    t.nx.push_back(w.normal.x); t.ny.push_back(w.normal.y); t.nz.push_back(w.normal.z);
-    t.vx.push_back(w.velocity.x); t.vy.push_back(w.velocity.y); t.vz.push_back(w.velocity.z);
-    t.kn.push_back(w.material.kn); t.ks.push_back(w.material.ks);
-    t.friction.push_back(w.material.friction);
-    t.plane.push_back(w.kind == Wall::Kind::plane ? 1 : 0);
+    for (auto* c : {&t.px, &t.py, &t.pz, &t.nx, &t.ny, &t.nz, &t.vx, &t.vy, &t.vz, &t.kn, &t.ks,
+                    &t.friction})
+      c->reserve(nw);
+    t.plane.reserve(nw);
+    for (const Wall& w : s.walls.walls) {
+      const Vec3 point = w.point + w.displacement;
+      t.px.push_back(point.x); t.py.push_back(point.y); t.pz.push_back(point.z);
+      t.nx.push_back(w.normal.x); t.ny.push_back(w.normal.y); t.nz.push_back(w.normal.z);
+      t.vx.push_back(w.velocity.x); t.vy.push_back(w.velocity.y); t.vz.push_back(w.velocity.z);
+      t.kn.push_back(w.material.kn); t.ks.push_back(w.material.ks);
+      t.friction.push_back(w.material.friction);
+      t.plane.push_back(w.kind == Wall::Kind::plane ? 1 : 0);
+    }
   }
   const ParticleStore& p = s.p;
   const kernels::PlaneWallArgs plane_args{
@@ -200,12 +208,11 @@ StageLoop wall_stage(State& s) {
   const auto plane_tail = rot ? kernels::scalar_kernels().plane_walls
                               : kernels::scalar_kernels().plane_walls_norot;
   const std::size_t lanes = s.kernels->lanes;
-  st.run = [&s, nw, sums, plane_args, plane_kernel, plane_tail, lanes](std::size_t blk) {
+  st.run = [&s, nw, sums, plane_args, plane_kernel, plane_tail, lanes, rot](std::size_t blk) {
     ParticleStore& p = s.p;
     WallContacts& wc = s.walls.contacts;
     const auto& walls = s.walls.walls;
     const double dt = s.dt;
-    const bool rot = s.any_rotating;
     const std::uint8_t* plane = sums->plane.data();
     double* slip = sums->slip.data();
     double* work = sums->work.data();
