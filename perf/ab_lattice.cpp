@@ -1,0 +1,119 @@
+// In-process A/B of two engine builds on the peers' lattice scene (perf/ab.sh builds them):
+//
+//   build/perf/ab_lattice A/libasperity_ab.so B/libasperity_ab.so n=40 rounds=30 steps=10
+//
+// Both modules build the scene; then `rounds` times each runs `steps` steps, in alternating order,
+// each timed on the wall clock. Printed: per build the best and median ns per particle-step, the
+// median of the per-round ratios B/A (the figure to quote: both halves of a round saw the same
+// machine), and whether the two trajectories are bitwise the same (a digest of every position).
+#include <dlfcn.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace {
+
+struct Module {
+  void* (*make)(int, int);
+  void (*cycle)(void*, long);
+  long (*particles)(void*);
+  unsigned long long (*digest)(void*);
+  void (*free)(void*);
+  void* run = nullptr;
+};
+
+template <class F>
+void bind(void* lib, const char* path, const char* name, F& f) {
+  f = reinterpret_cast<F>(dlsym(lib, name));
+  if (!f) {
+    std::fprintf(stderr, "ab_lattice: %s has no symbol %s (not built by perf/ab.sh?)\n", path, name);
+    std::exit(2);
+  }
+}
+
+Module load(const char* path) {
+  void* lib = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+  if (!lib) {
+    std::fprintf(stderr, "ab_lattice: cannot load %s: %s\n", path, dlerror());
+    std::exit(2);
+  }
+  Module m;
+  bind(lib, path, "asperity_ab_make", m.make);
+  bind(lib, path, "asperity_ab_cycle", m.cycle);
+  bind(lib, path, "asperity_ab_particles", m.particles);
+  bind(lib, path, "asperity_ab_digest", m.digest);
+  bind(lib, path, "asperity_ab_free", m.free);
+  return m;
+}
+
+[[noreturn]] void usage(const char* why) {
+  std::fprintf(stderr,
+               "ab_lattice: %s\nusage: ab_lattice A.so B.so [n=40] [rounds=30] [steps=10] "
+               "[warmup=200] [threads=1]\n",
+               why);
+  std::exit(2);
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t h = v.size() / 2;
+  return v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 3) usage("two modules are needed");
+  long n = 40, rounds = 30, steps = 10, warmup = 200, threads = 1;
+  for (int i = 3; i < argc; ++i) {
+    const char* eq = std::strchr(argv[i], '=');
+    if (!eq) usage((std::string("expected key=value, got ") + argv[i]).c_str());
+    const std::string key(argv[i], std::size_t(eq - argv[i]));
+    char* end = nullptr;
+    const long v = std::strtol(eq + 1, &end, 10);
+    if (*end || v < 1) usage((std::string("not a positive integer: ") + argv[i]).c_str());
+    if (key == "n") n = v;
+    else if (key == "rounds") rounds = v;
+    else if (key == "steps") steps = v;
+    else if (key == "warmup") warmup = v;
+    else if (key == "threads") threads = v;
+    else usage((std::string("unknown key ") + key).c_str());
+  }
+  Module m[2] = {load(argv[1]), load(argv[2])};
+  for (Module& x : m) {
+    x.run = x.make(int(n), int(threads));
+    x.cycle(x.run, warmup);
+  }
+  const double particles = double(m[0].particles(m[0].run));
+  std::vector<double> t[2], ratio;
+  using Clock = std::chrono::steady_clock;
+  for (long r = 0; r < rounds; ++r) {
+    double s[2];
+    for (int k = 0; k < 2; ++k) {
+      const int v = (r % 2) ? 1 - k : k;  // A first in even rounds, B first in odd ones
+      const auto t0 = Clock::now();
+      m[v].cycle(m[v].run, steps);
+      s[v] = std::chrono::duration<double>(Clock::now() - t0).count();
+      t[v].push_back(1e9 * s[v] / (particles * double(steps)));
+    }
+    ratio.push_back(s[1] / s[0]);
+  }
+  std::printf("lattice n=%ld, %.0f particles, %ld rounds of %ld steps, %ld thread(s)\n", n,
+              particles, rounds, steps, threads);
+  for (int v = 0; v < 2; ++v)
+    std::printf("%s: best %.2f, median %.2f ns/particle-step  (%s)\n", v ? "B" : "A",
+                *std::min_element(t[v].begin(), t[v].end()), median(t[v]), argv[1 + v]);
+  std::printf("B/A time: median of the rounds' ratios %.3f (quartiles %.3f-%.3f)\n", median(ratio),
+              [&] { auto q = ratio; std::sort(q.begin(), q.end()); return q[q.size() / 4]; }(),
+              [&] { auto q = ratio; std::sort(q.begin(), q.end()); return q[(3 * q.size()) / 4]; }());
+  const bool same = m[0].digest(m[0].run) == m[1].digest(m[1].run);
+  std::printf("trajectories: %s\n", same ? "bitwise the same" : "DIFFERENT");
+  for (Module& x : m) x.free(x.run);
+  return 0;
+}
