@@ -52,29 +52,39 @@ inline void carry_shear(const T& ox, const T& oy, const T& oz, const T& nx, cons
   fz = rz * cs + (nx * ry - ny * rx) * sn + nz * nr;
 }
 
-// Forces of one contact whose geometry is known: normal n (from a to b), overlap U, lever arms
-// la = |xc - xa|, lb = |xc - xb| (xc - xa = la n, xc - xb = -lb n), rest overlap U0 (the
-// overlap of the unloaded spring: 0 in model.md 4; > 0 for a contact left by a bond installed
-// stress-free). On entry (o, F) hold the normal and shear force of the previous step; on exit F
-// is the new shear force on b and fn the normal force on b. Returns the energy dissipated by slip
-// in this step.
+// Kinematics of one contact whose geometry is known: normal n (from a to b), lever arms
+// la = |xc - xa|, lb = |xc - xb| (xc - xa = la n, xc - xb = -lb n). Gives the tangential
+// relative velocity Vs of b with respect to a at the contact point and the mean spin angle of the
+// step about n, phi = 0.5 (wA + wB).n dt (contact_forces).
 template <class T>
-inline T contact_forces(const T& nx, const T& ny, const T& nz, const T& U, const T& la,
-                        const T& lb, const T& vax, const T& vay, const T& vaz, const T& wax,
-                        const T& way, const T& waz, const T& vbx, const T& vby, const T& vbz,
-                        const T& wbx, const T& wby, const T& wbz, const T& ox, const T& oy,
-                        const T& oz, const T& U0, T& fx, T& fy, T& fz, T& fn,
-                        const LawParams<T>& p) {
-  const auto touching = U > T(0.0);
+inline void contact_kinematics(const T& nx, const T& ny, const T& nz, const T& la, const T& lb,
+                               const T& vax, const T& vay, const T& vaz, const T& wax,
+                               const T& way, const T& waz, const T& vbx, const T& vby,
+                               const T& vbz, const T& wbx, const T& wby, const T& wbz,
+                               const T& dt, T& vsx, T& vsy, T& vsz, T& phi) {
   // Relative velocity of b with respect to a at the contact point [3-17, 3-18]:
   // V = (vB + wB x (xc - xB)) - (vA + wA x (xc - xA)) = vB - vA - lb (wB x n) - la (wA x n).
   const T vx = (vbx - vax) - lb * (wby * nz - wbz * ny) - la * (way * nz - waz * ny);
   const T vy = (vby - vay) - lb * (wbz * nx - wbx * nz) - la * (waz * nx - wax * nz);
   const T vz = (vbz - vaz) - lb * (wbx * ny - wby * nx) - la * (wax * ny - way * nx);
   const T vn = vx * nx + vy * ny + vz * nz;
-  const T vsx = vx - vn * nx, vsy = vy - vn * ny, vsz = vz - vn * nz;
+  vsx = vx - vn * nx;
+  vsy = vy - vn * ny;
+  vsz = vz - vn * nz;
+  phi = 0.5 * dt * ((wax + wbx) * nx + (way + wby) * ny + (waz + wbz) * nz);
+}
 
-  const T phi = 0.5 * p.dt * ((wax + wbx) * nx + (way + wby) * ny + (waz + wbz) * nz);
+// Forces of one contact from its geometry (normal n, overlap U) and kinematics (Vs, phi:
+// contact_kinematics), with rest overlap U0 (the overlap of the unloaded spring: 0 in model.md 4;
+// > 0 for a contact left by a bond installed stress-free). On entry (o, F) hold the normal and
+// shear force of the previous step; on exit F is the new shear force on b and fn the normal
+// force on b. Returns the energy dissipated by slip in this step.
+template <class T>
+inline T contact_response(const T& nx, const T& ny, const T& nz, const T& U, const T& vsx,
+                          const T& vsy, const T& vsz, const T& phi, const T& ox, const T& oy,
+                          const T& oz, const T& U0, T& fx, T& fy, T& fz, T& fn,
+                          const LawParams<T>& p) {
+  const auto touching = U > T(0.0);
   carry_shear(ox, oy, oz, nx, ny, nz, phi, fx, fy, fz);
   // Incremental shear force [3-19..3-21]: dFs = -ks Vs dt.
   fx = fx - p.ks * vsx * p.dt;
@@ -96,6 +106,21 @@ inline T contact_forces(const T& nx, const T& ny, const T& nz, const T& U, const
   fy = select(touching, fy * scale, T(0.0));
   fz = select(touching, fz * scale, T(0.0));
   return slip_energy;
+}
+
+// Both in one: the contact law of model.md 4 for a contact whose geometry is known (normal n,
+// overlap U, lever arms la, lb), from the two bodies' velocities.
+template <class T>
+inline T contact_forces(const T& nx, const T& ny, const T& nz, const T& U, const T& la,
+                        const T& lb, const T& vax, const T& vay, const T& vaz, const T& wax,
+                        const T& way, const T& waz, const T& vbx, const T& vby, const T& vbz,
+                        const T& wbx, const T& wby, const T& wbz, const T& ox, const T& oy,
+                        const T& oz, const T& U0, T& fx, T& fy, T& fz, T& fn,
+                        const LawParams<T>& p) {
+  T vsx, vsy, vsz, phi;
+  contact_kinematics(nx, ny, nz, la, lb, vax, vay, vaz, wax, way, waz, vbx, vby, vbz, wbx, wby,
+                     wbz, p.dt, vsx, vsy, vsz, phi);
+  return contact_response(nx, ny, nz, U, vsx, vsy, vsz, phi, ox, oy, oz, U0, fx, fy, fz, fn, p);
 }
 
 // Geometry of a ball-ball pair [3-10, 3-11].

@@ -9,45 +9,74 @@
 
 namespace asperity::kernels {
 
+// Pairs per stage of the loop below: its scratch (8 columns) stays in L1.
+inline constexpr std::size_t kPairStage = 128;
+
+// The contact law of one pair is a chain of some 150 dependent operations (two square roots,
+// three divisions) in a body of ~400 instructions, more than the out-of-order window of a core
+// holds, so consecutive batches hardly overlap. The loop therefore runs in two passes over
+// stages of kPairStage pairs: geometry and kinematics (positions and velocities in, n, U, Vs,
+// phi out to an L1 scratch), then the response (history in, forces and records out). Each body
+// is about half as long; the operations are those of contact_forces, so the results are the
+// same bit for bit.
 template <class Lanes, bool Rotation>
 double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
   using T = typename Lanes::Real;
   const LawParams<T> p{T(k.kn), T(k.ks), T(k.friction), T(k.dt)};
   T slip_sum(0.0);
-  for (std::size_t i = begin; i < end; i += Lanes::size) {
-    const auto ia = Lanes::index(k.a + i);
-    const auto ib = Lanes::index(k.b + i);
-    const ASide<Lanes> A(k.a + i, ia, k.columns);
-    const T xa = A.gather(k.x), ya = A.gather(k.y), za = A.gather(k.z);
-    const T xb = Lanes::gather(k.x, ib), yb = Lanes::gather(k.y, ib), zb = Lanes::gather(k.z, ib);
-    const T ra = A.gather(k.radius), rb = Lanes::gather(k.radius, ib);
-    T nx, ny, nz, U, la, lb;
-    ball_ball_geometry(xa, ya, za, xb, yb, zb, ra, rb, nx, ny, nz, U, la, lb);
-
-    const T vax = A.gather(k.vx), vay = A.gather(k.vy), vaz = A.gather(k.vz);
-    const T vbx = Lanes::gather(k.vx, ib), vby = Lanes::gather(k.vy, ib), vbz = Lanes::gather(k.vz, ib);
-    T wax(0.0), way(0.0), waz(0.0), wbx(0.0), wby(0.0), wbz(0.0);
-    if constexpr (Rotation) {
-      wax = A.gather(k.wx); way = A.gather(k.wy); waz = A.gather(k.wz);
-      wbx = Lanes::gather(k.wx, ib); wby = Lanes::gather(k.wy, ib); wbz = Lanes::gather(k.wz, ib);
+  alignas(64) double scratch[8][kPairStage];
+  for (std::size_t first = begin; first < end; first += kPairStage) {
+    const std::size_t last = first + kPairStage < end ? first + kPairStage : end;
+    for (std::size_t i = first; i < last; i += Lanes::size) {
+      const std::size_t j = i - first;
+      const auto ia = Lanes::index(k.a + i);
+      const auto ib = Lanes::index(k.b + i);
+      const ASide<Lanes> A(k.a + i, ia, k.columns);
+      const T xa = A.gather(k.x), ya = A.gather(k.y), za = A.gather(k.z);
+      const T xb = Lanes::gather(k.x, ib), yb = Lanes::gather(k.y, ib), zb = Lanes::gather(k.z, ib);
+      const T ra = A.gather(k.radius), rb = Lanes::gather(k.radius, ib);
+      T nx, ny, nz, U, la, lb;
+      ball_ball_geometry(xa, ya, za, xb, yb, zb, ra, rb, nx, ny, nz, U, la, lb);
+      const T vax = A.gather(k.vx), vay = A.gather(k.vy), vaz = A.gather(k.vz);
+      const T vbx = Lanes::gather(k.vx, ib), vby = Lanes::gather(k.vy, ib), vbz = Lanes::gather(k.vz, ib);
+      T wax(0.0), way(0.0), waz(0.0), wbx(0.0), wby(0.0), wbz(0.0);
+      if constexpr (Rotation) {
+        wax = A.gather(k.wx); way = A.gather(k.wy); waz = A.gather(k.wz);
+        wbx = Lanes::gather(k.wx, ib); wby = Lanes::gather(k.wy, ib); wbz = Lanes::gather(k.wz, ib);
+      }
+      T vsx, vsy, vsz, phi;
+      contact_kinematics(nx, ny, nz, la, lb, vax, vay, vaz, wax, way, waz, vbx, vby, vbz, wbx,
+                         wby, wbz, p.dt, vsx, vsy, vsz, phi);
+      Lanes::store(scratch[0] + j, nx); Lanes::store(scratch[1] + j, ny);
+      Lanes::store(scratch[2] + j, nz); Lanes::store(scratch[3] + j, U);
+      Lanes::store(scratch[4] + j, vsx); Lanes::store(scratch[5] + j, vsy);
+      Lanes::store(scratch[6] + j, vsz); Lanes::store(scratch[7] + j, phi);
     }
-    const T ox = Lanes::load(k.nx + i), oy = Lanes::load(k.ny + i), oz = Lanes::load(k.nz + i);
-    T fx = Lanes::load(k.fsx + i), fy = Lanes::load(k.fsy + i), fz = Lanes::load(k.fsz + i);
-    const T u0 = k.rest ? Lanes::load(k.rest + i) : T(0.0);
-    T fn;
-    slip_sum = slip_sum + contact_forces(nx, ny, nz, U, la, lb, vax, vay, vaz, wax, way, waz, vbx,
-                                         vby, vbz, wbx, wby, wbz, ox, oy, oz, u0, fx, fy, fz, fn, p);
-    // A pair that no longer touches forgets its rest overlap with its shear force.
-    if (k.rest) Lanes::store(k.rest + i, select(U > T(0.0), u0, T(0.0)));
-    Lanes::store(k.nx + i, nx); Lanes::store(k.ny + i, ny); Lanes::store(k.nz + i, nz);
-    Lanes::store(k.fsx + i, fx); Lanes::store(k.fsy + i, fy); Lanes::store(k.fsz + i, fz);
-    Lanes::store(k.fn + i, fn);
-    Lanes::store(k.overlap + i, U);
-    // For the gather (kernels/integrate.cpp), with the operations it would do per side: the
-    // record fx fy fz U cx cy cz 0 of each pair (store/pairs.hpp).
-    const T record[8] = {fn * nx + fx, fn * ny + fy, fn * nz + fz, U,
-                         ny * fz - nz * fy, nz * fx - nx * fz, nx * fy - ny * fx, T(0.0)};
-    Lanes::template store_records<8>(k.out + 8 * i, record);
+    for (std::size_t i = first; i < last; i += Lanes::size) {
+      const std::size_t j = i - first;
+      const T nx = Lanes::load(scratch[0] + j), ny = Lanes::load(scratch[1] + j),
+              nz = Lanes::load(scratch[2] + j), U = Lanes::load(scratch[3] + j);
+      const T ox = Lanes::load(k.nx + i), oy = Lanes::load(k.ny + i), oz = Lanes::load(k.nz + i);
+      T fx = Lanes::load(k.fsx + i), fy = Lanes::load(k.fsy + i), fz = Lanes::load(k.fsz + i);
+      const T u0 = k.rest ? Lanes::load(k.rest + i) : T(0.0);
+      T fn;
+      slip_sum = slip_sum + contact_response(nx, ny, nz, U, Lanes::load(scratch[4] + j),
+                                             Lanes::load(scratch[5] + j),
+                                             Lanes::load(scratch[6] + j),
+                                             Lanes::load(scratch[7] + j), ox, oy, oz, u0, fx,
+                                             fy, fz, fn, p);
+      // A pair that no longer touches forgets its rest overlap with its shear force.
+      if (k.rest) Lanes::store(k.rest + i, select(U > T(0.0), u0, T(0.0)));
+      Lanes::store(k.nx + i, nx); Lanes::store(k.ny + i, ny); Lanes::store(k.nz + i, nz);
+      Lanes::store(k.fsx + i, fx); Lanes::store(k.fsy + i, fy); Lanes::store(k.fsz + i, fz);
+      Lanes::store(k.fn + i, fn);
+      Lanes::store(k.overlap + i, U);
+      // For the gather (kernels/integrate.cpp), with the operations it would do per side: the
+      // record fx fy fz U cx cy cz 0 of each pair (store/pairs.hpp).
+      const T record[8] = {fn * nx + fx, fn * ny + fy, fn * nz + fz, U,
+                           ny * fz - nz * fy, nz * fx - nx * fz, nx * fy - ny * fx, T(0.0)};
+      Lanes::template store_records<8>(k.out + 8 * i, record);
+    }
   }
   return Lanes::sum(slip_sum);
 }
