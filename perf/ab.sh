@@ -5,6 +5,7 @@
 # shared machine differ by up to 2x within minutes, which buries the 5-20 % a change is worth.
 #
 #   perf/ab.sh A B [n=40] [rounds=30] [steps=10] [warmup=200] [threads=1]
+#   ASPERITY_AB_BONDED=1 perf/ab.sh A B ...     # the lattice bonded (the bond kernel's scene)
 #
 # A, B: source trees (directories) or git revisions of this repository, checked out as detached
 # worktrees under ${TMPDIR:-/tmp}/asperity-ab/. Each is built in <tree>/build-ab (Release,

@@ -6,6 +6,7 @@
 //
 // Only a C interface is exported (the build hides every other symbol), so the two modules' engines,
 // with the same C++ names, never see each other.
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 
@@ -19,11 +20,24 @@ struct Run {
 
 extern "C" {
 
+// ASPERITY_AB_BONDED=1 in the environment: every touching pair bonded, unbreakable, as
+// `perf/lattice.lua bonded=true` (the bond kernel's scene), with the automatic time step.
 __attribute__((visibility("default"))) void* asperity_ab_make(int n, int threads) {
   asperity::perf::LatticeOptions o;
   o.n = n;
   o.threads = threads;
-  return new Run{asperity::perf::make_lattice(o)};
+  auto* run = new Run{asperity::perf::make_lattice(o)};
+  const char* bonded = std::getenv("ASPERITY_AB_BONDED");
+  if (bonded && std::strcmp(bonded, "1") == 0) {
+    run->world.cycle(1);  // the neighbour list the bonds are installed from
+    asperity::BondMaterial bm;
+    bm.beam_kn = 0.1;
+    bm.beam_ks = 0.1 * 2.0 / 7.0;
+    bm.breakable = false;
+    run->world.install_bonds(bm);
+    run->world.set_dt(0);
+  }
+  return run;
 }
 
 __attribute__((visibility("default"))) void asperity_ab_cycle(void* run, long steps) {
