@@ -12,6 +12,7 @@ namespace asperity::kernels {
 
 // Scalar twins of the xsimd functions the templates call unqualified (found by ADL for batches).
 inline double select(bool m, double a, double b) { return m ? a : b; }
+inline bool any(bool m) { return m; }
 using std::sqrt;
 using std::abs;
 
@@ -97,10 +98,15 @@ inline T contact_response(const T& nx, const T& ny, const T& nz, const T& U, con
   // |Fs_cap|) / ks (model.md 8).
   const T limit = p.friction * fn;
   const T fs2 = fx * fx + fy * fy + fz * fz;
+  // The square root and two divisions only where some lane slips (same values: the selects
+  // give 1 and 0 to the others).
   const auto slips = fs2 > limit * limit;
-  const T fs = sqrt(fs2);
-  const T scale = select(slips, limit / fs, T(1.0));
-  const T slip_energy = select(slips && touching, limit * (fs - limit) / p.ks, T(0.0));
+  T scale(1.0), slip_energy(0.0);
+  if (any(slips)) {
+    const T fs = sqrt(fs2);
+    scale = select(slips, limit / fs, T(1.0));
+    slip_energy = select(slips && touching, limit * (fs - limit) / p.ks, T(0.0));
+  }
   // A contact that does not touch has no force and forgets its shear history [model.md 4].
   fx = select(touching, fx * scale, T(0.0));
   fy = select(touching, fy * scale, T(0.0));
