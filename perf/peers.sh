@@ -142,7 +142,7 @@ wait_quiet() {
 # --- the runs ----------------------------------------------------------------------------------
 cpu=$(awk -F': *' '/^model name/ { print $2; exit }' /proc/cpuinfo)
 cpu=${cpu:-$(uname -m)}
-declare -A best best_cpu
+declare -A best best_cpu rates
 simd=unknown
 echo "lattice n=$N ($((N * N * N)) particles), $STEPS timed steps after 200 warm-up, cores: $CORES, rounds: $ROUNDS"
 echo "cpu: $cpu ($(getconf _NPROCESSORS_ONLN) cores), load average: $(cut -d' ' -f1-3 /proc/loadavg)"
@@ -160,6 +160,7 @@ for r in $(seq 1 "$ROUNDS"); do
       fi
       [[ $e == asperity ]] && simd=$(awk '/^simd:/ { sub(",", "", $2); print $2; exit }' "$log")
       crate=$(cpu_rate "$e" "$log")
+      rates[$e,$c,$r]=$rate
       printf '  round %d  %-9s %d core(s)  %12.4g particle-steps/s' "$r" "$e" "$c" "$rate"
       [[ -n $crate ]] && printf '  (%.4g per CPU-second)' "$crate"
       printf '\n'
@@ -187,6 +188,27 @@ for e in $ENGINES; do
   done
   printf '  %s\n' "$ratios"
 done
+# Paired ratios: asperity against each engine within each round (the two ran minutes apart, so
+# a machine whose speed drifts slows both alike); the median over the rounds is the figure to
+# quote on a shared machine, with the smallest and largest round.
+if [[ $ROUNDS -gt 1 ]]; then
+  for e in $ENGINES; do
+    [[ $e == asperity || -z ${available[$e]:-} ]] && continue
+    line=""
+    for c in $CORES; do
+      list=""
+      for r in $(seq 1 "$ROUNDS"); do
+        a=${rates[asperity,$c,$r]:-} p=${rates[$e,$c,$r]:-}
+        [[ -n $a && -n $p ]] && list+=$(awk -v a="$a" -v p="$p" 'BEGIN { printf "%.4f ", a / p }')
+      done
+      [[ -z $list ]] && continue
+      line+=$(echo "$list" | tr ' ' '\n' | sed '/^$/d' | sort -g | awk -v c="$c" '{ v[NR] = $1 }
+        END { m = (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2
+              printf "  %.2fx@%s (rounds %.2f-%.2f)", m, c, v[1], v[NR] }')
+    done
+    echo "asperity/$e, median of the rounds' paired ratios:$line"
+  done
+fi
 a1=${best_cpu[asperity,1]:-} l1=${best_cpu[lammps,1]:-}
 if [[ -n $a1 && -n $l1 ]]; then
   awk -v a="$a1" -v l="$l1" 'BEGIN { printf "1 core, per CPU-second (robust on a busy machine): asperity %.4g, lammps %.4g, ratio %.2fx\n", a, l, a / l }'
