@@ -63,7 +63,12 @@ inline void gather_vector(const GatherArgs& g, std::size_t begin, std::size_t en
   constexpr std::size_t width = Bonds ? 12 : 8;
   static const double sign[2] = {-1.0, 1.0};  // by the entry's "is b" bit
   const __m256d half = _mm256_set1_pd(0.5);
+  constexpr std::size_t ahead = 8;  // particles (GatherArgs::prefetch)
   for (std::size_t i = begin; i < end; ++i) {
+    if (g.prefetch && i + ahead < end)
+      for (std::int32_t e = g.start[i + ahead]; e < g.start[i + ahead + 1]; ++e)
+        _mm_prefetch(reinterpret_cast<const char*>(g.records + width * std::size_t(g.entry[e] >> 1)),
+                     _MM_HINT_T0);
     if (gather_skips(g, i) || (Bonds && g.start[i] == g.start[i + 1])) continue;
     const __m256d R = _mm256_set1_pd(g.radius[i]);
     __m256d f = _mm256_setzero_pd(), t = _mm256_setzero_pd();

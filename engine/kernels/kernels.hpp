@@ -95,6 +95,10 @@ struct GatherArgs {
   const std::uint8_t* inert; const std::uint8_t* idle;
   double* fx; double* fy; double* fz;
   double* tx; double* ty; double* tz;
+  // Prefetch the records of the particle eight ahead (vector gathers only): for record arrays
+  // past the caches, whose lines the incidences reach out of order (kernels/integrate.cpp,
+  // kPrefetchRecords; perf/README.md).
+  bool prefetch = false;
 };
 
 using GatherKernel = void (*)(const GatherArgs&, std::size_t begin, std::size_t end);
