@@ -1,6 +1,7 @@
 // In-process A/B of two engine builds on the peers' lattice scene (perf/ab.sh builds them):
 //
 //   build/perf/ab_lattice A/libasperity_ab.so B/libasperity_ab.so n=40 rounds=30 steps=10
+//   build/perf/ab_lattice A.so A.so n=22 nb=100   # one build, cost per particle-step against size
 //
 // Both modules build the scene; then `rounds` times each runs `steps` steps, in alternating order,
 // each timed on the wall clock. Printed: per build the best and median ns per particle-step, the
@@ -54,7 +55,7 @@ Module load(const char* path) {
 
 [[noreturn]] void usage(const char* why) {
   std::fprintf(stderr,
-               "ab_lattice: %s\nusage: ab_lattice A.so B.so [n=40] [rounds=30] [steps=10] "
+               "ab_lattice: %s\nusage: ab_lattice A.so B.so [n=40] [nb=n] [rounds=30] [steps=10] "
                "[warmup=200] [threads=1]\n",
                why);
   std::exit(2);
@@ -70,7 +71,7 @@ double median(std::vector<double> v) {
 
 int main(int argc, char** argv) {
   if (argc < 3) usage("two modules are needed");
-  long n = 40, rounds = 30, steps = 10, warmup = 200, threads = 1;
+  long n = 40, nb = 0, rounds = 30, steps = 10, warmup = 200, threads = 1;
   for (int i = 3; i < argc; ++i) {
     const char* eq = std::strchr(argv[i], '=');
     if (!eq) usage((std::string("expected key=value, got ") + argv[i]).c_str());
@@ -79,18 +80,23 @@ int main(int argc, char** argv) {
     const long v = std::strtol(eq + 1, &end, 10);
     if (*end || v < 1) usage((std::string("not a positive integer: ") + argv[i]).c_str());
     if (key == "n") n = v;
+    else if (key == "nb") nb = v;
     else if (key == "rounds") rounds = v;
     else if (key == "steps") steps = v;
     else if (key == "warmup") warmup = v;
     else if (key == "threads") threads = v;
     else usage((std::string("unknown key ") + key).c_str());
   }
+  if (nb == 0) nb = n;
   Module m[2] = {load(argv[1]), load(argv[2])};
-  for (Module& x : m) {
-    x.run = x.make(int(n), int(threads));
-    x.cycle(x.run, warmup);
+  for (int v = 0; v < 2; ++v) {
+    m[v].run = m[v].make(int(v ? nb : n), int(threads));
+    m[v].cycle(m[v].run, warmup);
   }
-  const double particles = double(m[0].particles(m[0].run));
+  // nb != n (the same build twice, say): cost per particle-step against size in one process; B
+  // runs about as many particle-steps per round as A.
+  const double particles[2] = {double(m[0].particles(m[0].run)), double(m[1].particles(m[1].run))};
+  const long count[2] = {steps, std::max(1L, long(double(steps) * particles[0] / particles[1] + 0.5))};
   std::vector<double> t[2], ratio;
   using Clock = std::chrono::steady_clock;
   for (long r = 0; r < rounds; ++r) {
@@ -98,22 +104,26 @@ int main(int argc, char** argv) {
     for (int k = 0; k < 2; ++k) {
       const int v = (r % 2) ? 1 - k : k;  // A first in even rounds, B first in odd ones
       const auto t0 = Clock::now();
-      m[v].cycle(m[v].run, steps);
-      s[v] = std::chrono::duration<double>(Clock::now() - t0).count();
-      t[v].push_back(1e9 * s[v] / (particles * double(steps)));
+      m[v].cycle(m[v].run, count[v]);
+      s[v] = std::chrono::duration<double>(Clock::now() - t0).count() / (particles[v] * double(count[v]));
+      t[v].push_back(1e9 * s[v]);
     }
     ratio.push_back(s[1] / s[0]);
   }
   std::printf("lattice n=%ld, %.0f particles, %ld rounds of %ld steps, %ld thread(s)\n", n,
-              particles, rounds, steps, threads);
+              particles[0], rounds, steps, threads);
+  if (nb != n)
+    std::printf("B: lattice n=%ld, %.0f particles, %ld steps a round\n", nb, particles[1], count[1]);
   for (int v = 0; v < 2; ++v)
     std::printf("%s: best %.2f, median %.2f ns/particle-step  (%s)\n", v ? "B" : "A",
                 *std::min_element(t[v].begin(), t[v].end()), median(t[v]), argv[1 + v]);
-  std::printf("B/A time: median of the rounds' ratios %.3f (quartiles %.3f-%.3f)\n", median(ratio),
+  std::printf("B/A time per particle-step: median of the rounds' ratios %.3f (quartiles %.3f-%.3f)\n", median(ratio),
               [&] { auto q = ratio; std::sort(q.begin(), q.end()); return q[q.size() / 4]; }(),
               [&] { auto q = ratio; std::sort(q.begin(), q.end()); return q[(3 * q.size()) / 4]; }());
-  const bool same = m[0].digest(m[0].run) == m[1].digest(m[1].run);
-  std::printf("trajectories: %s\n", same ? "bitwise the same" : "DIFFERENT");
+  if (nb == n) {
+    const bool same = m[0].digest(m[0].run) == m[1].digest(m[1].run);
+    std::printf("trajectories: %s\n", same ? "bitwise the same" : "DIFFERENT");
+  }
   for (Module& x : m) x.free(x.run);
   return 0;
 }
