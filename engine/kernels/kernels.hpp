@@ -27,6 +27,7 @@ struct PairKernelArgs {
   // Rest overlaps (store/pairs.hpp), read and, where the pair no longer touches, reset to 0;
   // null: every rest overlap is 0 and the column is not touched.
   double* rest = nullptr;
+  bool stream = false;  // non-temporal record stores (pairs.cpp: record arrays past the caches)
 };
 
 using PairKernel = double (*)(const PairKernelArgs&, std::size_t begin, std::size_t end);

@@ -75,7 +75,14 @@ double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
       // record fx fy fz U cx cy cz 0 of each pair (store/pairs.hpp).
       const T record[8] = {fn * nx + fx, fn * ny + fy, fn * nz + fz, U,
                            ny * fz - nz * fy, nz * fx - nx * fz, nx * fy - ny * fx, T(0.0)};
-      Lanes::template store_records<8>(k.out + 8 * i, record);
+      if constexpr (requires { Lanes::template stream_records<8>(k.out, record); }) {
+        if (k.stream)
+          Lanes::template stream_records<8>(k.out + 8 * i, record);
+        else
+          Lanes::template store_records<8>(k.out + 8 * i, record);
+      } else {
+        Lanes::template store_records<8>(k.out + 8 * i, record);
+      }
     }
   }
   return Lanes::sum(slip_sum);

@@ -1,4 +1,8 @@
 // Stage `contacts`: run the selected pair kernel over fixed blocks of the pair list.
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
 #include "state.hpp"
 
 namespace asperity::detail {
@@ -15,7 +19,13 @@ kernels::PairKernelArgs pair_kernel_args(State& s) {
 }
 
 StageLoop pair_stage(State& s) {
-  const auto args = pair_kernel_args(s);
+  auto args = pair_kernel_args(s);
+  // Record arrays past ~4 MB are written with non-temporal stores: the gather reads them out of
+  // order long after (and prefetches them, integrate.cpp), so the lines need not be read for
+  // ownership first. AVX2 machine of perf/README.md, in one process: lattice n = 40 0.91-0.96 on
+  // one thread, 0.86-0.91 on two; n = 46 0.90. In cache it would cost (n = 22: 1.16).
+  constexpr std::size_t kStreamRecords = std::size_t(4) << 20;  // bytes
+  args.stream = s.pairs.out.size() * sizeof(double) > kStreamRecords;
   const auto kernel = s.any_rotating ? s.kernels->pair : s.kernels->pair_norot;
   const std::size_t total = s.pairs.padded;
   StageLoop st;
@@ -25,6 +35,9 @@ StageLoop pair_stage(State& s) {
   st.run = [=](std::size_t blk) {
     const std::size_t begin = blk * kPairBlock;
     slip[blk] = kernel(args, begin, std::min(total, begin + kPairBlock));
+#if defined(__SSE2__)
+    if (args.stream) _mm_sfence();  // the streamed records are visible to every thread after it
+#endif
   };
   st.finish = [&s, slip, blocks = st.blocks] {
     if (s.settings.track_energy)

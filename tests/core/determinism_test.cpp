@@ -134,16 +134,20 @@ TEST(Determinism, SimdKernelsEqualTheScalarReferenceBitwise) {
     const auto& simd = kernels::select_kernels(arch);
     for (bool shared : {false, true})
     for (bool rest : {false, true})
-    for (bool rotation : {true, false}) {
+    for (bool rotation : {true, false})
+    for (bool stream : {false, true}) {  // records with non-temporal stores (large pair lists)
       RandomPairs ref(pairs, 11, shared), got(pairs, 11, shared);
       ref.with_rest = got.with_rest = rest;
       const auto& sk = kernels::scalar_kernels();
       const double slip_ref = (rotation ? sk.pair : sk.pair_norot)(ref.args(), 0, pairs);
-      const double slip_got = (rotation ? simd.pair : simd.pair_norot)(got.args(), 0, pairs);
+      auto got_args = got.args();
+      got_args.stream = stream;
+      const double slip_got = (rotation ? simd.pair : simd.pair_norot)(got_args, 0, pairs);
       auto same = [&](const auto& u, const auto& v) {
         return std::memcmp(u.data(), v.data(), pairs * sizeof(double)) == 0;
       };
-      const std::string what = arch + (shared ? " shared a" : " separate") + (rest ? " rest" : "");
+      const std::string what = arch + (shared ? " shared a" : " separate") + (rest ? " rest" : "") +
+                               (stream ? " streamed" : "");
       EXPECT_TRUE(same(ref.rest, got.rest)) << what;
       EXPECT_TRUE(same(ref.fn, got.fn)) << what;
       EXPECT_TRUE(same(ref.U, got.U)) << what;
