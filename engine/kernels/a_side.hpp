@@ -31,4 +31,31 @@ class ASide {
   bool window_;
 };
 
+// The particle values a batch of pairs or bonds reads, both sides: positions, radii, velocities
+// and (with Rotation) angular velocities, which stay 0 otherwise. Args: PairKernelArgs or
+// BondKernelArgs (kernels.hpp), which name their columns alike.
+template <class T>
+struct BatchSides {
+  T xa, ya, za, ra, vax, vay, vaz, wax, way, waz;
+  T xb, yb, zb, rb, vbx, vby, vbz, wbx, wby, wbz;
+};
+
+template <class Lanes, bool Rotation, class Args>
+inline BatchSides<typename Lanes::Real> load_sides(const Args& k, std::size_t i) {
+  using T = typename Lanes::Real;
+  const auto ia = Lanes::index(k.a + i);
+  const auto ib = Lanes::index(k.b + i);
+  const ASide<Lanes> A(k.a + i, ia, k.columns);
+  BatchSides<T> s{A.gather(k.x), A.gather(k.y), A.gather(k.z), A.gather(k.radius),
+                  A.gather(k.vx), A.gather(k.vy), A.gather(k.vz), T(0.0), T(0.0), T(0.0),
+                  Lanes::gather(k.x, ib), Lanes::gather(k.y, ib), Lanes::gather(k.z, ib),
+                  Lanes::gather(k.radius, ib), Lanes::gather(k.vx, ib), Lanes::gather(k.vy, ib),
+                  Lanes::gather(k.vz, ib), T(0.0), T(0.0), T(0.0)};
+  if constexpr (Rotation) {
+    s.wax = A.gather(k.wx); s.way = A.gather(k.wy); s.waz = A.gather(k.wz);
+    s.wbx = Lanes::gather(k.wx, ib); s.wby = Lanes::gather(k.wy, ib); s.wbz = Lanes::gather(k.wz, ib);
+  }
+  return s;
+}
+
 }  // namespace asperity::kernels

@@ -13,21 +13,9 @@ double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
   const bool breakable = k.strength > 0;
   T count(0.0);
   for (std::size_t i = begin; i < end; i += Lanes::size) {
-    const auto ia = Lanes::index(k.a + i);
-    const auto ib = Lanes::index(k.b + i);
-    const ASide<Lanes> A(k.a + i, ia, k.columns);
-    const T xa = A.gather(k.x), ya = A.gather(k.y), za = A.gather(k.z);
-    const T xb = Lanes::gather(k.x, ib), yb = Lanes::gather(k.y, ib), zb = Lanes::gather(k.z, ib);
-    const T ra = A.gather(k.radius), rb = Lanes::gather(k.radius, ib);
+    const BatchSides<T> q = load_sides<Lanes, Rotation>(k, i);
     T nx, ny, nz, U, la, lb;
-    ball_ball_geometry(xa, ya, za, xb, yb, zb, ra, rb, nx, ny, nz, U, la, lb);
-    const T vax = A.gather(k.vx), vay = A.gather(k.vy), vaz = A.gather(k.vz);
-    const T vbx = Lanes::gather(k.vx, ib), vby = Lanes::gather(k.vy, ib), vbz = Lanes::gather(k.vz, ib);
-    T wax(0.0), way(0.0), waz(0.0), wbx(0.0), wby(0.0), wbz(0.0);
-    if constexpr (Rotation) {
-      wax = A.gather(k.wx); way = A.gather(k.wy); waz = A.gather(k.wz);
-      wbx = Lanes::gather(k.wx, ib); wby = Lanes::gather(k.wy, ib); wbz = Lanes::gather(k.wz, ib);
-    }
+    ball_ball_geometry(q.xa, q.ya, q.za, q.xb, q.yb, q.zb, q.ra, q.rb, nx, ny, nz, U, la, lb);
     const T ox = Lanes::load(k.nx + i), oy = Lanes::load(k.ny + i), oz = Lanes::load(k.nz + i);
     BondState<T> s{Lanes::load(k.fsx + i), Lanes::load(k.fsy + i), Lanes::load(k.fsz + i), T(0.0),
                    Lanes::load(k.fbn + i), Lanes::load(k.fbsx + i), Lanes::load(k.fbsy + i),
@@ -39,8 +27,9 @@ double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
     const T rsafe = select(real, rbeam, T(1.0));
     const T u0 = k.rest ? Lanes::load(k.rest + i) : T(0.0);
     T sigma, tau;
-    const T crit = bond_forces(nx, ny, nz, U, la, lb, rsafe, vax, vay, vaz, wax, way, waz, vbx, vby,
-                               vbz, wbx, wby, wbz, ox, oy, oz, u0, s, sigma, tau, p);
+    const T crit = bond_forces(nx, ny, nz, U, la, lb, rsafe, q.vax, q.vay, q.vaz, q.wax, q.way,
+                               q.waz, q.vbx, q.vby, q.vbz, q.wbx, q.wby, q.wbz, ox, oy, oz, u0, s,
+                               sigma, tau, p);
     T brk(0.0);
     if (breakable) {
       brk = select(real & (crit >= T(1.0)), T(1.0), T(0.0));

@@ -86,7 +86,7 @@ struct FloatLanes {
   static F32 load(const double* p) { return F32(*p); }
   static void store(double* p, const F32& v) { *p = double(v.v); }
   static double sum(const F32& v) { return double(v.v); }
-  template <int Width>
+  template <int Width, bool Stream = false>  // Stream: ignored (plain stores)
   static void store_records(double* rec, const F32* v) {
     for (int j = 0; j < Width; ++j) rec[j] = double(v[j].v);
   }

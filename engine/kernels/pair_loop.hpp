@@ -29,24 +29,12 @@ double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
     const std::size_t last = first + kPairStage < end ? first + kPairStage : end;
     for (std::size_t i = first; i < last; i += Lanes::size) {
       const std::size_t j = i - first;
-      const auto ia = Lanes::index(k.a + i);
-      const auto ib = Lanes::index(k.b + i);
-      const ASide<Lanes> A(k.a + i, ia, k.columns);
-      const T xa = A.gather(k.x), ya = A.gather(k.y), za = A.gather(k.z);
-      const T xb = Lanes::gather(k.x, ib), yb = Lanes::gather(k.y, ib), zb = Lanes::gather(k.z, ib);
-      const T ra = A.gather(k.radius), rb = Lanes::gather(k.radius, ib);
+      const BatchSides<T> q = load_sides<Lanes, Rotation>(k, i);
       T nx, ny, nz, U, la, lb;
-      ball_ball_geometry(xa, ya, za, xb, yb, zb, ra, rb, nx, ny, nz, U, la, lb);
-      const T vax = A.gather(k.vx), vay = A.gather(k.vy), vaz = A.gather(k.vz);
-      const T vbx = Lanes::gather(k.vx, ib), vby = Lanes::gather(k.vy, ib), vbz = Lanes::gather(k.vz, ib);
-      T wax(0.0), way(0.0), waz(0.0), wbx(0.0), wby(0.0), wbz(0.0);
-      if constexpr (Rotation) {
-        wax = A.gather(k.wx); way = A.gather(k.wy); waz = A.gather(k.wz);
-        wbx = Lanes::gather(k.wx, ib); wby = Lanes::gather(k.wy, ib); wbz = Lanes::gather(k.wz, ib);
-      }
+      ball_ball_geometry(q.xa, q.ya, q.za, q.xb, q.yb, q.zb, q.ra, q.rb, nx, ny, nz, U, la, lb);
       T vsx, vsy, vsz, phi;
-      contact_kinematics(nx, ny, nz, la, lb, vax, vay, vaz, wax, way, waz, vbx, vby, vbz, wbx,
-                         wby, wbz, p.dt, vsx, vsy, vsz, phi);
+      contact_kinematics(nx, ny, nz, la, lb, q.vax, q.vay, q.vaz, q.wax, q.way, q.waz, q.vbx,
+                         q.vby, q.vbz, q.wbx, q.wby, q.wbz, p.dt, vsx, vsy, vsz, phi);
       Lanes::store(scratch[0] + j, nx); Lanes::store(scratch[1] + j, ny);
       Lanes::store(scratch[2] + j, nz); Lanes::store(scratch[3] + j, U);
       Lanes::store(scratch[4] + j, vsx); Lanes::store(scratch[5] + j, vsy);
@@ -75,14 +63,10 @@ double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
       // record fx fy fz U cx cy cz 0 of each pair (store/pairs.hpp).
       const T record[8] = {fn * nx + fx, fn * ny + fy, fn * nz + fz, U,
                            ny * fz - nz * fy, nz * fx - nx * fz, nx * fy - ny * fx, T(0.0)};
-      if constexpr (requires { Lanes::template stream_records<8>(k.out, record); }) {
-        if (k.stream)
-          Lanes::template stream_records<8>(k.out + 8 * i, record);
-        else
-          Lanes::template store_records<8>(k.out + 8 * i, record);
-      } else {
+      if (k.stream)  // large record arrays (kernels.hpp)
+        Lanes::template store_records<8, true>(k.out + 8 * i, record);
+      else
         Lanes::template store_records<8>(k.out + 8 * i, record);
-      }
     }
   }
   return Lanes::sum(slip_sum);

@@ -22,7 +22,7 @@ struct ScalarLanes {
   static void store_u(double* p, double v) { *p = v; }
   static std::int64_t index32(const std::int32_t* p) { return *p; }
   static double sum(double v) { return v; }
-  template <int Width>
+  template <int Width, bool Stream = false>  // Stream: ignored (plain stores)
   static void store_records(double* rec, const double* v) {
     for (int j = 0; j < Width; ++j) rec[j] = v[j];
   }

@@ -89,26 +89,10 @@ struct SimdLanes {
   // Records (store/pairs.hpp, store/bonds.hpp): v[j] holds value j of the batch's pairs or bonds;
   // the Width values of item p go to rec[Width p .. Width p + Width - 1]. A transpose of the rows,
   // then full-line stores per item (half lines on AVX2, quarters on SSE). rec is 64-byte
-  // aligned for Width 8, 32-byte aligned for Width 12.
-  // The same with non-temporal stores (AVX2; elsewhere the plain ones): for record arrays past
-  // the caches, whose lines then need no read for ownership.
-  template <int Width>
-  static void stream_records(double* rec, const Real* v) {
-#if defined(__AVX2__) && !defined(__AVX512F__)
-    static_assert(Width == 8, "pair records");
-    for (int h = 0; h < Width; h += 4) {
-      const __m256d t0 = _mm256_unpacklo_pd(v[h], v[h + 1]), t1 = _mm256_unpackhi_pd(v[h], v[h + 1]);
-      const __m256d t2 = _mm256_unpacklo_pd(v[h + 2], v[h + 3]), t3 = _mm256_unpackhi_pd(v[h + 2], v[h + 3]);
-      _mm256_stream_pd(rec + h, _mm256_permute2f128_pd(t0, t2, 0x20));
-      _mm256_stream_pd(rec + Width + h, _mm256_permute2f128_pd(t1, t3, 0x20));
-      _mm256_stream_pd(rec + 2 * Width + h, _mm256_permute2f128_pd(t0, t2, 0x31));
-      _mm256_stream_pd(rec + 3 * Width + h, _mm256_permute2f128_pd(t1, t3, 0x31));
-    }
-#else
-    store_records<Width>(rec, v);
-#endif
-  }
-  template <int Width>
+  // aligned for Width 8, 32-byte aligned for Width 12. Stream: non-temporal stores on AVX2 (for
+  // record arrays past the caches, whose lines then need no read for ownership; measured there
+  // only), plain ones elsewhere.
+  template <int Width, bool Stream = false>
   static void store_records(double* rec, const Real* v) {
     static_assert(Width == 8 || Width == 12, "records of 8 or 12 values");
 #if defined(__AVX512F__)
@@ -144,10 +128,14 @@ struct SimdLanes {
     for (int h = 0; h < Width; h += 4) {  // values h..h+3: a 4 x 4 transpose each
       const __m256d t0 = _mm256_unpacklo_pd(v[h], v[h + 1]), t1 = _mm256_unpackhi_pd(v[h], v[h + 1]);
       const __m256d t2 = _mm256_unpacklo_pd(v[h + 2], v[h + 3]), t3 = _mm256_unpackhi_pd(v[h + 2], v[h + 3]);
-      _mm256_store_pd(rec + h, _mm256_permute2f128_pd(t0, t2, 0x20));
-      _mm256_store_pd(rec + Width + h, _mm256_permute2f128_pd(t1, t3, 0x20));
-      _mm256_store_pd(rec + 2 * Width + h, _mm256_permute2f128_pd(t0, t2, 0x31));
-      _mm256_store_pd(rec + 3 * Width + h, _mm256_permute2f128_pd(t1, t3, 0x31));
+      auto put = [](double* p, __m256d r) {
+        if constexpr (Stream) _mm256_stream_pd(p, r);
+        else _mm256_store_pd(p, r);
+      };
+      put(rec + h, _mm256_permute2f128_pd(t0, t2, 0x20));
+      put(rec + Width + h, _mm256_permute2f128_pd(t1, t3, 0x20));
+      put(rec + 2 * Width + h, _mm256_permute2f128_pd(t0, t2, 0x31));
+      put(rec + 3 * Width + h, _mm256_permute2f128_pd(t1, t3, 0x31));
     }
 #else
     static_assert(size == 2, "SSE: two lanes");
