@@ -52,6 +52,14 @@ struct Ledger {
 inline constexpr std::size_t kPairBlock = 1024;      // multiple of kMaxLanes
 inline constexpr std::size_t kParticleBlock = 512;
 
+// A per-pair or per-bond record array this large is taken to be past the caches: the pair kernel
+// writes it with non-temporal stores (kernels/pairs.cpp) and the gather prefetches it
+// (kernels/integrate.cpp). Measured on the AVX2 machine of perf/README.md: both pay at 12 MB
+// (lattice n = 40) and would cost 3-16 % at 2 MB (n = 22), where the records stay in cache.
+inline bool records_past_caches(const AVec<double>& records) {
+  return records.size() * sizeof(double) > (std::size_t(4) << 20);
+}
+
 struct ParticleBlockResult {
   double damping = 0, gravity = 0, applied = 0;
   double kinetic = 0;        // at the step's time level: from the mean of old and new velocities

@@ -29,12 +29,7 @@ __attribute__((visibility("default"))) void* asperity_ab_make(int n, int threads
   auto* run = new Run{asperity::perf::make_lattice(o)};
   const char* bonded = std::getenv("ASPERITY_AB_BONDED");
   if (bonded && std::strcmp(bonded, "1") == 0) {
-    run->world.cycle(1);  // the neighbour list the bonds are installed from
-    asperity::BondMaterial bm;
-    bm.beam_kn = 0.1;
-    bm.beam_ks = 0.1 * 2.0 / 7.0;
-    bm.breakable = false;
-    run->world.install_bonds(bm);
+    asperity::perf::bond_lattice(run->world);
     run->world.set_dt(0);
   }
   return run;

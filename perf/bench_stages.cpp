@@ -54,14 +54,7 @@ struct SceneCache {
       o.threads = 1;
       o.reorder_interval = 0;  // stages are timed on the creation order; see perf/README.md
       world = std::make_unique<World>(asperity::perf::make_lattice(o));
-      if (k == "bond") {
-        world->cycle(1);  // the neighbour list the bonds are installed from
-        asperity::BondMaterial bm;
-        bm.beam_kn = 0.1;
-        bm.beam_ks = 0.1 * 2.0 / 7.0;
-        bm.breakable = false;
-        world->install_bonds(bm);
-      }
+      if (k == "bond") asperity::perf::bond_lattice(*world);
       world->cycle(2);  // neighbour list, wall contacts, history, dt estimate in place
       n = edge;
       kind = k;

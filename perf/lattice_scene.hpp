@@ -76,4 +76,17 @@ inline World make_lattice(const LatticeOptions& o) {
   return w;
 }
 
+// Every touching pair of a lattice bonded, unbreakable, with the REV's bond stiffnesses (as
+// `perf/lattice.lua bonded=true`): the bond kernel's scene. One step first builds the neighbour
+// list the bonds are installed from. The time step stays as it was (callers that step the block
+// for long set it back to automatic: the peers' 5e-4 s is above its critical step).
+inline void bond_lattice(World& w) {
+  w.cycle(1);
+  BondMaterial bm;
+  bm.beam_kn = 0.1;
+  bm.beam_ks = 0.1 * 2.0 / 7.0;
+  bm.breakable = false;
+  w.install_bonds(bm);
+}
+
 }  // namespace asperity::perf

@@ -47,18 +47,17 @@ StageLoop integrate_stage(State& s) {
   // ones, as below).
   const auto gather_pairs = s.kernels->gather_pairs, gather_bonds = s.kernels->gather_bonds;
   kernels::GatherArgs pair_args{inc.start.data(), inc.entry.data(), q.out.data(),
-                                      p.radius.data(), p.inert.data(), idle, p.fx.data(),
-                                      p.fy.data(), p.fz.data(), p.tx.data(), p.ty.data(),
-                                      p.tz.data()};
+                                p.radius.data(), p.inert.data(), idle, p.fx.data(),
+                                p.fy.data(), p.fz.data(), p.tx.data(), p.ty.data(),
+                                p.tz.data()};
   kernels::GatherArgs bond_args = pair_args;
   bond_args.start = binc.start.data();
   bond_args.entry = binc.entry.data();
   bond_args.records = bq.out.data();
-  // Records past ~4 MB are prefetched a few particles ahead: lattice n = 40 (12 MB) 0.93 of the
-  // step time on one thread, 0.85 on two; in cache (the joint's bonds, 0.9 MB) it costs ~3 %.
-  constexpr std::size_t kPrefetchRecords = std::size_t(4) << 20;  // bytes
-  pair_args.prefetch = q.out.size() * sizeof(double) > kPrefetchRecords;
-  bond_args.prefetch = bq.out.size() * sizeof(double) > kPrefetchRecords;
+  // Records past the caches are prefetched a few particles ahead: lattice n = 40 (12 MB) 0.93 of
+  // the step time on one thread, 0.85 on two; in cache (the joint's bonds, 0.9 MB) it costs ~3 %.
+  pair_args.prefetch = records_past_caches(q.out);
+  bond_args.prefetch = records_past_caches(bq.out);
   // The wall and applied terms, added in passes after them. Raw pointers captured by value: the
   // stores to the force columns cannot make the compiler reload them (a vector's data pointer
   // reached through a reference can look aliased).

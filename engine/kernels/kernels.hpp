@@ -98,7 +98,7 @@ struct GatherArgs {
   double* tx; double* ty; double* tz;
   // Prefetch the records of the particle eight ahead (vector gathers only): for record arrays
   // past the caches, whose lines the incidences reach out of order (kernels/integrate.cpp,
-  // kPrefetchRecords; perf/README.md).
+  // records_past_caches in state.hpp; perf/README.md).
   bool prefetch = false;
 };
 

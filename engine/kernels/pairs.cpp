@@ -20,12 +20,11 @@ kernels::PairKernelArgs pair_kernel_args(State& s) {
 
 StageLoop pair_stage(State& s) {
   auto args = pair_kernel_args(s);
-  // Record arrays past ~4 MB are written with non-temporal stores: the gather reads them out of
+  // Records past the caches are written with non-temporal stores: the gather reads them out of
   // order long after (and prefetches them, integrate.cpp), so the lines need not be read for
   // ownership first. AVX2 machine of perf/README.md, in one process: lattice n = 40 0.91-0.96 on
   // one thread, 0.86-0.91 on two; n = 46 0.90. In cache it would cost (n = 22: 1.16).
-  constexpr std::size_t kStreamRecords = std::size_t(4) << 20;  // bytes
-  args.stream = s.pairs.out.size() * sizeof(double) > kStreamRecords;
+  args.stream = records_past_caches(s.pairs.out);
   const auto kernel = s.any_rotating ? s.kernels->pair : s.kernels->pair_norot;
   const std::size_t total = s.pairs.padded;
   StageLoop st;
