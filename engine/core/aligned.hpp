@@ -13,6 +13,18 @@ inline constexpr std::size_t kAlignment = 64;
 // kernel needs a tail loop.
 inline constexpr std::size_t kMaxLanes = 8;
 
+inline std::size_t round_up(std::size_t n, std::size_t m) { return (n + m - 1) / m * m; }
+
+namespace detail_memory {
+// Arrays of at least this many bytes are mapped on their own, on transparent huge pages where
+// the system offers them, each starting at a different cache line (core/aligned.cpp: why, and
+// what it measured). Smaller ones come from the heap.
+inline constexpr std::size_t kLargeArray = std::size_t(256) << 10;
+void* allocate_large(std::size_t bytes);
+void release_large(void* p);
+bool large_arrays_mapped();  // false under AddressSanitizer and off Linux: heap, no stagger
+}  // namespace detail_memory
+
 template <class T>
 struct AlignedAllocator {
   using value_type = T;
@@ -21,18 +33,20 @@ struct AlignedAllocator {
   AlignedAllocator(const AlignedAllocator<U>&) {}
   T* allocate(std::size_t n) {
     std::size_t bytes = (n * sizeof(T) + kAlignment - 1) / kAlignment * kAlignment;
+    if (bytes >= detail_memory::kLargeArray) return static_cast<T*>(detail_memory::allocate_large(bytes));
     void* p = std::aligned_alloc(kAlignment, bytes == 0 ? kAlignment : bytes);
     if (!p) throw std::bad_alloc();
     return static_cast<T*>(p);
   }
-  void deallocate(T* p, std::size_t) { std::free(p); }
+  void deallocate(T* p, std::size_t n) {
+    if (round_up(n * sizeof(T), kAlignment) >= detail_memory::kLargeArray) detail_memory::release_large(p);
+    else std::free(p);
+  }
   template <class U>
   bool operator==(const AlignedAllocator<U>&) const { return true; }
 };
 
 template <class T>
 using AVec = std::vector<T, AlignedAllocator<T>>;
-
-inline std::size_t round_up(std::size_t n, std::size_t m) { return (n + m - 1) / m * m; }
 
 }  // namespace asperity
