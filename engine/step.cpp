@@ -129,7 +129,7 @@ void check_overlaps(State& s) {
   double worst = 0;
   std::int64_t worst_i = -1;
   for (std::size_t k = 0; k < s.pairs.n; ++k) {
-    const double U = s.pairs.overlap[k];
+    const double U = s.pairs.overlap_at(k);
     if (!(U > 0)) continue;
     const auto a = s.pairs.a[k], b = s.pairs.b[k];
     const double r = U / std::min(p.radius[a], p.radius[b]);
@@ -158,7 +158,7 @@ double estimate_critical_dt(const State& s) {
   const double kc = std::max(m.kn, m.ks);
   std::vector<double> ktran(n, 0.0), krot(n, 0.0);
   for (std::size_t k = 0; k < s.pairs.n; ++k) {
-    const double U = s.pairs.overlap[k];
+    const double U = s.pairs.overlap_at(k);
     if (!(U > 0)) continue;
     const auto a = s.pairs.a[k], b = s.pairs.b[k];
     ktran[a] += kc;
@@ -223,8 +223,8 @@ Energies compute_energies(const State& s) {
   const ContactMaterial& m = s.settings.contact;
   const PairStore& q = s.pairs;
   for (std::size_t k = 0; k < q.n; ++k) {
-    if (!(q.overlap[k] > 0)) continue;
-    e.strain += q.fn[k] * q.fn[k] / (2 * m.kn) +
+    if (!(q.overlap_at(k) > 0)) continue;
+    e.strain += q.normal_force(k) * q.normal_force(k) / (2 * m.kn) +
                 (q.fsx[k] * q.fsx[k] + q.fsy[k] * q.fsy[k] + q.fsz[k] * q.fsz[k]) / (2 * m.ks);
   }
   const WallContacts& wc = s.walls.contacts;

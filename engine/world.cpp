@@ -552,14 +552,14 @@ ContactSummary World::contact_summary(int tag_a, int tag_b, std::uint8_t flag_ma
   const auto& q = s.pairs;
   ContactSummary out;
   for (std::size_t k = 0; k < q.n; ++k) {
-    const double U = q.overlap[k];
+    const double U = q.overlap_at(k);
     if (!(U > 0)) continue;
     const auto a = q.a[k], b = q.b[k];
     double sign;  // force on the tag_b particle is sign * (force on b)
     if (p.tag[a] == tag_a && p.tag[b] == tag_b) sign = 1;
     else if (p.tag[a] == tag_b && p.tag[b] == tag_a) sign = -1;
     else continue;
-    const Vec3 f = (Vec3{q.nx[k], q.ny[k], q.nz[k]} * q.fn[k] + Vec3{q.fsx[k], q.fsy[k], q.fsz[k]}) * sign;
+    const Vec3 f = (Vec3{q.nx[k], q.ny[k], q.nz[k]} * q.normal_force(k) + Vec3{q.fsx[k], q.fsy[k], q.fsz[k]}) * sign;
     const double Rm = 0.5 * (p.radius[a] + p.radius[b]);
     ++out.count;
     out.area += 3.14159265358979323846 * (Rm * U - 0.25 * U * U);  // [4-1, 4-2]
@@ -807,7 +807,7 @@ double World::unbalanced_force_ratio() const {
   double contact = 0;
   std::size_t contacts = 0;
   for (std::size_t k = 0; k < s.pairs.n; ++k)
-    if (s.pairs.overlap[k] > 0) { contact += s.pairs.fn[k]; ++contacts; }
+    if (s.pairs.overlap_at(k) > 0) { contact += s.pairs.normal_force(k); ++contacts; }
   for (std::size_t k = 0; k < s.walls.contacts.n; ++k)
     if (s.walls.contacts.overlap[k] > 0) { contact += s.walls.contacts.fn[k]; ++contacts; }
   if (bodies == 0) return 0;
@@ -822,15 +822,15 @@ std::vector<ContactInfo> World::contacts() const {
   const auto& q = s.pairs;
   std::vector<ContactInfo> out;
   for (std::size_t k = 0; k < q.n; ++k) {
-    if (!(q.overlap[k] > 0)) continue;
+    if (!(q.overlap_at(k) > 0)) continue;
     const auto a = q.a[k], b = q.b[k];
     ContactInfo c;
     c.id_a = p.id[a];
     c.id_b = p.id[b];
     c.normal = {q.nx[k], q.ny[k], q.nz[k]};
-    c.overlap = q.overlap[k];
+    c.overlap = q.overlap_at(k);
     c.point = Vec3{p.x[a], p.y[a], p.z[a]} + c.normal * (p.radius[a] - 0.5 * c.overlap);  // [3-11]
-    c.normal_force = q.fn[k];
+    c.normal_force = q.normal_force(k);
     c.shear_force = {q.fsx[k], q.fsy[k], q.fsz[k]};
     if (c.id_a > c.id_b) {  // report with id_a < id_b: flip the roles
       std::swap(c.id_a, c.id_b);
@@ -848,7 +848,7 @@ std::vector<ContactInfo> World::contacts() const {
 std::size_t World::contact_count() const {
   const auto& q = state_->pairs;
   std::size_t c = 0;
-  for (std::size_t k = 0; k < q.n; ++k) c += q.overlap[k] > 0;
+  for (std::size_t k = 0; k < q.n; ++k) c += q.overlap_at(k) > 0;
   return c;
 }
 

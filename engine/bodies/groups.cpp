@@ -186,7 +186,7 @@ void update_servo_stiffness(State& s) {
   };
   const double kn = s.settings.contact.kn;
   for (std::uint32_t k : s.group_pairs)
-    if (s.pairs.overlap[k] > 0) add(s.pairs.a[k], s.pairs.b[k], kn);
+    if (s.pairs.overlap_at(k) > 0) add(s.pairs.a[k], s.pairs.b[k], kn);
   for (std::size_t k = 0; k < s.bonds.n; ++k) add(s.bonds.a[k], s.bonds.b[k], kn + s.bonds.material.beam_kn);
   const WallContacts& wc = s.walls.contacts;
   for (std::size_t k = 0; k < wc.n; ++k) {

@@ -197,6 +197,7 @@ void visit(Io& io, State& s) {
     io.scalar(at + "/padded", q->padded);
     io.column(at + "/a", q->a);
     io.column(at + "/b", q->b);
+    if constexpr (std::is_same_v<Io, Writer>) q->columns_from_records();  // fn and U of the last step
     for (auto [name, col] : {std::pair{"nx", &q->nx}, {"ny", &q->ny}, {"nz", &q->nz},
                              {"fsx", &q->fsx}, {"fsy", &q->fsy}, {"fsz", &q->fsz},
                              {"fn", &q->fn}, {"overlap", &q->overlap}})
@@ -370,7 +371,7 @@ void World::save(const std::string& path) const {
     int version = kCheckpointVersion;
     w.scalar("asperity_checkpoint_version", version);
     detail::sync_lazy(const_cast<State&>(*state_));  // idle members to where they are (not observable)
-    visit(w, const_cast<State&>(*state_));  // the writer only reads
+    visit(w, const_cast<State&>(*state_));  // the writer only reads (and fills the fn and U columns from the records)
   }
   file.commit();
 }

@@ -15,9 +15,8 @@ struct PairKernelArgs {
   const std::int64_t* a; const std::int64_t* b;
   double* nx; double* ny; double* nz;
   double* fsx; double* fsy; double* fsz;
-  double* fn; double* overlap;
-  // Output for the gather (store/pairs.hpp): per pair the record fx fy fz U cx cy cz 0, eight
-  // doubles from out + 8 k (64-byte aligned).
+  // Output for the gather and the readers of normal forces and overlaps (store/pairs.hpp): per
+  // pair the record fx fy fz U cx cy cz fn, eight doubles from out + 8 k (64-byte aligned).
   double* out;
   double kn, ks, friction, dt;
   // Length of the particle columns. A batch whose a-side particles lie within one lane-width

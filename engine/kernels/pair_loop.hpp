@@ -57,12 +57,11 @@ double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
       if (k.rest) Lanes::store(k.rest + i, select(U > T(0.0), u0, T(0.0)));
       Lanes::store(k.nx + i, nx); Lanes::store(k.ny + i, ny); Lanes::store(k.nz + i, nz);
       Lanes::store(k.fsx + i, fx); Lanes::store(k.fsy + i, fy); Lanes::store(k.fsz + i, fz);
-      Lanes::store(k.fn + i, fn);
-      Lanes::store(k.overlap + i, U);
-      // For the gather (kernels/integrate.cpp), with the operations it would do per side: the
-      // record fx fy fz U cx cy cz 0 of each pair (store/pairs.hpp).
+      // For the gather (kernels/integrate.cpp), with the operations it would do per side, and
+      // for the readers of fn and U: the record fx fy fz U cx cy cz fn of each pair
+      // (store/pairs.hpp). fn and U have no columns of their own to store to.
       const T record[8] = {fn * nx + fx, fn * ny + fy, fn * nz + fz, U,
-                           ny * fz - nz * fy, nz * fx - nx * fz, nx * fy - ny * fx, T(0.0)};
+                           ny * fz - nz * fy, nz * fx - nx * fz, nx * fy - ny * fx, fn};
       if (k.stream)  // large record arrays (kernels.hpp)
         Lanes::template store_records<8, true>(k.out + 8 * i, record);
       else

@@ -14,7 +14,7 @@ kernels::PairKernelArgs pair_kernel_args(State& s) {
   return {p.x.data(), p.y.data(), p.z.data(), p.vx.data(), p.vy.data(), p.vz.data(),
           p.wx.data(), p.wy.data(), p.wz.data(), p.radius.data(), q.a.data(), q.b.data(),
           q.nx.data(), q.ny.data(), q.nz.data(), q.fsx.data(), q.fsy.data(), q.fsz.data(),
-          q.fn.data(), q.overlap.data(), q.out.data(), m.kn, m.ks, m.friction, s.dt, p.capacity,
+          q.out.data(), m.kn, m.ks, m.friction, s.dt, p.capacity,
           s.rest_overlaps ? q.rest.data() : nullptr};
 }
 
@@ -27,6 +27,7 @@ StageLoop pair_stage(State& s) {
   args.stream = records_past_caches(s.pairs.out);
   const auto kernel = s.any_rotating ? s.kernels->pair : s.kernels->pair_norot;
   const std::size_t total = s.pairs.padded;
+  s.pairs.outputs_in_records = true;  // the kernel writes fn and U to the records only
   StageLoop st;
   st.blocks = (total + kPairBlock - 1) / kPairBlock;
   s.pair_block_slip.assign(st.blocks, 0.0);

@@ -2,8 +2,10 @@
 // (a, b) current indices with a < b. Per pair it keeps the contact normal and the shear force
 // (both are also the history for the next step), the normal force and the overlap; and, for the
 // gather, one record per pair with the pair's force on b and n x Fs, which the SIMD kernel
-// computes eight pairs at a time instead of the scalar gather computing them once per side
-// (outputs of the step only: never carried, copied or saved).
+// computes eight pairs at a time instead of the scalar gather computing them once per side.
+// The pair kernel leaves the normal force and the overlap in the record too, not in their
+// columns (two stores a pair fewer: perf/README.md); read them with normal_force(k) and
+// overlap_at(k), which know where they are.
 //
 // Sign convention (model.md 4): n points from a to b; fn, fs act on b; -(fn n + fs) acts on a.
 #pragma once
@@ -22,18 +24,41 @@ struct PairStore {
   AVec<std::int64_t> a, b;
   AVec<double> nx, ny, nz;     // unit normal a -> b (history: normal of the last step)
   AVec<double> fsx, fsy, fsz;  // shear force on b (history)
-  AVec<double> fn;             // normal force on b along n (>= 0)
-  AVec<double> overlap;        // U = Ra + Rb - d (negative: not touching)
+  // Normal force on b along n (>= 0) and overlap U = Ra + Rb - d (negative: not touching), as the
+  // neighbour build or a checkpoint set them; after a step they are in the records
+  // (outputs_in_records): read them through normal_force(k) and overlap_at(k).
+  AVec<double> fn;
+  AVec<double> overlap;
   // Rest overlap (history): the overlap at which the normal spring is unloaded, Fn = kn (U - rest)
   // (model.md 4 has rest = 0). Only a contact left behind by a bond installed stress-free has
   // rest > 0 (World::install_bonds); it is forgotten with the shear force when U <= 0. The pair
   // kernel reads it only when State::rest_overlaps is set.
   AVec<double> rest;
-  // The gather's record of pair k: out[kPairRecord k + j], j = 0..7: fx fy fz U cx cy cz 0, the
-  // force on b fn n + fs (on a: its negative), the overlap, and n x fs (the torque on either
-  // particle is -(R - U/2) times it). One 64-byte line per pair: the gather reaches a pair
-  // through the incidence list in one line instead of seven columns (perf/README.md).
+  // The gather's record of pair k: out[kPairRecord k + j], j = 0..7: fx fy fz U cx cy cz fn, the
+  // force on b fn n + fs (on a: its negative), the overlap, n x fs (the torque on either
+  // particle is -(R - U/2) times it) and the normal force. One 64-byte line per pair: the gather
+  // reaches a pair through the incidence list in one line instead of seven columns
+  // (perf/README.md). Outputs of the step: not carried by rebuilds nor saved.
   AVec<double> out;
+  // Set by the pair stage: the current normal forces and overlaps are in the records (slots 7
+  // and 3), the fn and overlap columns are stale. Cleared where the columns are written.
+  bool outputs_in_records = false;
+
+  double normal_force(std::size_t k) const {
+    return outputs_in_records ? out[kPairRecord * k + 7] : fn[k];
+  }
+  double overlap_at(std::size_t k) const {
+    return outputs_in_records ? out[kPairRecord * k + 3] : overlap[k];
+  }
+  // The columns brought up to date from the records (before they are saved).
+  void columns_from_records() {
+    if (!outputs_in_records) return;
+    for (std::size_t k = 0; k < padded; ++k) {
+      fn[k] = out[kPairRecord * k + 7];
+      overlap[k] = out[kPairRecord * k + 3];
+    }
+    outputs_in_records = false;
+  }
 
   void resize(std::size_t count) {
     n = count;
@@ -41,10 +66,12 @@ struct PairStore {
     for (auto* c : {&a, &b}) c->resize(padded);
     for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &overlap, &rest}) c->resize(padded);
     size_outputs();
+    outputs_in_records = false;
   }
   // The gather's columns are not saved: a store read from a checkpoint sizes them here.
   void size_outputs() {
     out.resize(kPairRecord * padded);
+    outputs_in_records = false;
   }
   // Padding entries: pair of two null particles, unit normal along x, no force.
   void fill_padding(std::int64_t null_a, std::int64_t null_b) {
@@ -62,7 +89,7 @@ struct PairStore {
   void copy_history(const PairStore& from, std::size_t o, std::size_t k) {
     nx[k] = from.nx[o]; ny[k] = from.ny[o]; nz[k] = from.nz[o];
     fsx[k] = from.fsx[o]; fsy[k] = from.fsy[o]; fsz[k] = from.fsz[o];
-    fn[k] = from.fn[o]; overlap[k] = from.overlap[o]; rest[k] = from.rest[o];
+    fn[k] = from.normal_force(o); overlap[k] = from.overlap_at(o); rest[k] = from.rest[o];
   }
 };
 
