@@ -43,10 +43,22 @@ void restart_continues_bit_for_bit(bool stress_free_bonds) {
   // One file per test: ctest -j runs the two variants at once.
   const std::string path = temp_file(stress_free_bonds ? "asperity_checkpoint_test_stress_free.h5"
                                                        : "asperity_checkpoint_test.h5");
+  // The last step's normal forces and overlaps live in the pair records (store/pairs.hpp); the
+  // loaded world must report the same contacts and strain energy before it takes a step.
+  const std::vector<ContactInfo> saved = w.contacts();
+  const double saved_strain = w.energies().strain;
+  ASSERT_GT(saved.size(), 10u);
   w.save(path);
   w.cycle(700);
 
   World r = World::load(path, 1, "scalar");
+  const std::vector<ContactInfo> loaded = r.contacts();
+  ASSERT_EQ(loaded.size(), saved.size());
+  for (std::size_t k = 0; k < saved.size(); ++k) {
+    EXPECT_EQ(loaded[k].normal_force, saved[k].normal_force) << k;
+    EXPECT_EQ(loaded[k].overlap, saved[k].overlap) << k;
+  }
+  EXPECT_EQ(r.energies().strain, saved_strain);
   EXPECT_EQ(r.step_count() + 700, w.step_count());
   r.cycle(700);
   EXPECT_TRUE(same(w.positions(), r.positions()));
