@@ -2,6 +2,7 @@
 //
 //   build/perf/ab_lattice A/libasperity_ab.so B/libasperity_ab.so n=40 rounds=30 steps=10
 //   build/perf/ab_lattice A.so A.so n=22 nb=100   # one build, cost per particle-step against size
+//   build/perf/ab_lattice A.so A.so n=30 bonded_b=1   # one build, the bonded block against the lattice
 //
 // Both modules build the scene; then `rounds` times each runs `steps` steps, in alternating order,
 // each timed on the wall clock. Printed: per build the best and median ns per particle-step, the
@@ -56,7 +57,7 @@ Module load(const char* path) {
 [[noreturn]] void usage(const char* why) {
   std::fprintf(stderr,
                "ab_lattice: %s\nusage: ab_lattice A.so B.so [n=40] [nb=n] [rounds=30] [steps=10] "
-               "[warmup=200] [threads=1]\n",
+               "[warmup=200] [threads=1] [bonded_b=0]\n",
                why);
   std::exit(2);
 }
@@ -71,7 +72,7 @@ double median(std::vector<double> v) {
 
 int main(int argc, char** argv) {
   if (argc < 3) usage("two modules are needed");
-  long n = 40, nb = 0, rounds = 30, steps = 10, warmup = 200, threads = 1;
+  long n = 40, nb = 0, rounds = 30, steps = 10, warmup = 200, threads = 1, bonded_b = 0;
   for (int i = 3; i < argc; ++i) {
     const char* eq = std::strchr(argv[i], '=');
     if (!eq) usage((std::string("expected key=value, got ") + argv[i]).c_str());
@@ -85,11 +86,18 @@ int main(int argc, char** argv) {
     else if (key == "steps") steps = v;
     else if (key == "warmup") warmup = v;
     else if (key == "threads") threads = v;
+    else if (key == "bonded_b") bonded_b = v;
     else usage((std::string("unknown key ") + key).c_str());
   }
   if (nb == 0) nb = n;
   Module m[2] = {load(argv[1]), load(argv[2])};
   for (int v = 0; v < 2; ++v) {
+    // bonded_b=1: A the plain lattice, B bonded (ab_module.cpp reads the variable when it makes
+    // a scene): the bonded block's throughput against the lattice's, in one process.
+    if (bonded_b) {
+      if (v == 1) setenv("ASPERITY_AB_BONDED", "1", 1);
+      else unsetenv("ASPERITY_AB_BONDED");
+    }
     m[v].run = m[v].make(int(v ? nb : n), int(threads));
     m[v].cycle(m[v].run, warmup);
   }
@@ -112,15 +120,16 @@ int main(int argc, char** argv) {
   }
   std::printf("lattice n=%ld, %.0f particles, %ld rounds of %ld steps, %ld thread(s)\n", n,
               particles[0], rounds, steps, threads);
-  if (nb != n)
-    std::printf("B: lattice n=%ld, %.0f particles, %ld steps a round\n", nb, particles[1], count[1]);
+  if (nb != n || bonded_b)
+    std::printf("B: lattice n=%ld%s, %.0f particles, %ld steps a round\n", nb, bonded_b ? " bonded" : "",
+                particles[1], count[1]);
   for (int v = 0; v < 2; ++v)
     std::printf("%s: best %.2f, median %.2f ns/particle-step  (%s)\n", v ? "B" : "A",
                 *std::min_element(t[v].begin(), t[v].end()), median(t[v]), argv[1 + v]);
   std::printf("B/A time per particle-step: median of the rounds' ratios %.3f (quartiles %.3f-%.3f)\n", median(ratio),
               [&] { auto q = ratio; std::sort(q.begin(), q.end()); return q[q.size() / 4]; }(),
               [&] { auto q = ratio; std::sort(q.begin(), q.end()); return q[(3 * q.size()) / 4]; }());
-  if (nb == n) {
+  if (nb == n && !bonded_b) {
     const bool same = m[0].digest(m[0].run) == m[1].digest(m[1].run);
     std::printf("trajectories: %s\n", same ? "bitwise the same" : "DIFFERENT");
   }
