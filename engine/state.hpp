@@ -119,8 +119,12 @@ struct State {
 
   // Pairs joining two different bodies (group / group or group / free particle) of the current
   // pair list, for the servo's per-step stiffness; valid while `rebuilds` equals group_pairs_at.
-  std::vector<std::uint32_t> group_pairs;
+  // Likewise the bonds joining two bodies (a joint's ~9000 bonds, of which a few hundred tie the
+  // platens: scanning them all every step was 3 % of its elastic step), valid while also the bond
+  // count is group_bonds_of (breaks compact the list; any other change rebuilds).
+  std::vector<std::uint32_t> group_pairs, group_bonds;
   std::uint64_t group_pairs_at = ~std::uint64_t(0);
+  std::size_t group_bonds_of = 0;
 
   // Idle group members (see Group::busy), per particle index; valid while idle_valid (the split
   // is redone at every neighbour build and after the API changes motions or applied forces).

@@ -171,11 +171,15 @@ void update_servo_stiffness(State& s) {
     for (Dof d : g.motion.translation) servo = servo || d == Dof::servo;
   if (!servo) return;
   const ParticleStore& p = s.p;
-  if (s.group_pairs_at != s.rebuilds) {
+  if (s.group_pairs_at != s.rebuilds || s.group_bonds_of != s.bonds.n) {
     s.group_pairs.clear();
     for (std::size_t k = 0; k < s.pairs.n; ++k)
       if (p.group[s.pairs.a[k]] != p.group[s.pairs.b[k]]) s.group_pairs.push_back(std::uint32_t(k));
+    s.group_bonds.clear();
+    for (std::size_t k = 0; k < s.bonds.n; ++k)
+      if (p.group[s.bonds.a[k]] != p.group[s.bonds.b[k]]) s.group_bonds.push_back(std::uint32_t(k));
     s.group_pairs_at = s.rebuilds;
+    s.group_bonds_of = s.bonds.n;
   }
   std::vector<double> K(s.groups.size(), 0.0);
   auto add = [&](std::int64_t a, std::int64_t b, double k) {
@@ -187,7 +191,8 @@ void update_servo_stiffness(State& s) {
   const double kn = s.settings.contact.kn;
   for (std::uint32_t k : s.group_pairs)
     if (s.pairs.overlap_at(k) > 0) add(s.pairs.a[k], s.pairs.b[k], kn);
-  for (std::size_t k = 0; k < s.bonds.n; ++k) add(s.bonds.a[k], s.bonds.b[k], kn + s.bonds.material.beam_kn);
+  // The same sums as over every pair and bond: the others (one body) add nothing.
+  for (std::uint32_t k : s.group_bonds) add(s.bonds.a[k], s.bonds.b[k], kn + s.bonds.material.beam_kn);
   const WallContacts& wc = s.walls.contacts;
   for (std::size_t k = 0; k < wc.n; ++k) {
     const int g = p.group[wc.particle[k]];
