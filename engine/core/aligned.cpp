@@ -3,7 +3,7 @@
 // Why: the columns of a scene past the caches (the lattice n = 40 holds ~40 MB in some forty
 // columns) are walked by many streams at once, each on its own 4 kB pages; with 2 MB pages the
 // page walks go. Measured in one process (perf/ab.sh, lattice, AVX2 machine of perf/README.md):
-// 0.90-0.92 of the step time at n = 40, 0.95 at n = 100 (1e6 particles), 0.93 on two threads.
+// 0.90-0.92 of the step time at n = 40, 0.95 at n = 100 (1e6 particles), 0.93-0.96 on two threads.
 //
 // Why the stagger: arrays that all start on a 2 MB boundary put element i of every column in the
 // same L1 and L2 sets, and the pair kernel reads some twenty columns at one index: that was

@@ -32,18 +32,22 @@ struct AlignedAllocator {
   template <class U>
   AlignedAllocator(const AlignedAllocator<U>&) {}
   T* allocate(std::size_t n) {
-    std::size_t bytes = (n * sizeof(T) + kAlignment - 1) / kAlignment * kAlignment;
+    const std::size_t bytes = bytes_for(n);
     if (bytes >= detail_memory::kLargeArray) return static_cast<T*>(detail_memory::allocate_large(bytes));
     void* p = std::aligned_alloc(kAlignment, bytes == 0 ? kAlignment : bytes);
     if (!p) throw std::bad_alloc();
     return static_cast<T*>(p);
   }
+  // The same size decides how an array was allocated and how it is released.
   void deallocate(T* p, std::size_t n) {
-    if (round_up(n * sizeof(T), kAlignment) >= detail_memory::kLargeArray) detail_memory::release_large(p);
+    if (bytes_for(n) >= detail_memory::kLargeArray) detail_memory::release_large(p);
     else std::free(p);
   }
   template <class U>
   bool operator==(const AlignedAllocator<U>&) const { return true; }
+
+ private:
+  static std::size_t bytes_for(std::size_t n) { return round_up(n * sizeof(T), kAlignment); }
 };
 
 template <class T>

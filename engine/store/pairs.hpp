@@ -65,8 +65,7 @@ struct PairStore {
     padded = round_up(count, kMaxLanes);
     for (auto* c : {&a, &b}) c->resize(padded);
     for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &overlap, &rest}) c->resize(padded);
-    size_outputs();
-    outputs_in_records = false;
+    size_outputs();  // which also marks the columns as current
   }
   // The gather's columns are not saved: a store read from a checkpoint sizes them here.
   void size_outputs() {
