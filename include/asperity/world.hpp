@@ -3,8 +3,8 @@
 // header (plus vec3.hpp / error.hpp); the stores and kernels behind it live in engine/.
 //
 // Identity: every particle gets a stable id (0, 1, 2, ... in order of creation). Internally the
-// particles are reordered along a space-filling curve for cache locality, so array positions
-// change; every function here speaks in stable ids.
+// particles are reordered by cell for cache locality (a Morton curve; the raster order of the
+// cells in large scenes), so array positions change; every function here speaks in stable ids.
 #pragma once
 
 #include <array>
@@ -57,7 +57,7 @@ struct WorldSettings {
                                     // bonds, or per 20 000 particles, up to the cores available)
   std::string simd = "auto";        // "auto", "scalar", "sse4_2", "avx2", "avx512f"
   bool track_energy = true;         // friction, damping and boundary work ledgers (model.md 8)
-  int reorder_interval = 10;        // neighbour rebuilds between space-filling-curve reorders; 0: never
+  int reorder_interval = 10;        // neighbour rebuilds between reorders by cell; 0: never
   bool lock_bonded_rotation = true; // a particle holding an intact bond does not rotate (model.md 2)
 };
 
@@ -152,7 +152,7 @@ struct Energies {            // model.md 8; all in J
 
 struct StepStats {
   std::uint64_t rebuilds = 0;  // neighbour-list rebuilds so far
-  std::uint64_t reorders = 0;  // space-filling-curve reorders so far
+  std::uint64_t reorders = 0;  // reorders by cell so far
   std::size_t pairs = 0;       // pairs in the neighbour list (touching or not)
   std::size_t contacts = 0;    // touching ball-ball pairs
   std::size_t wall_contacts = 0;
