@@ -19,8 +19,8 @@
 //   advance with it as three sequential streams, which the hardware prefetchers follow; a Morton
 //   curve keeps more neighbours close but jumps across its block boundaries, and a Hilbert curve
 //   never jumps but turns every few cells. Lattice, one process, same build (perf/README.md):
-//   raster order 0.90-0.91 of Morton's time per step at n = 40 (64 000 particles) on one thread,
-//   0.93-0.96 on two, 0.90 at n = 56, 0.95-0.98 at n = 30; Hilbert 1.03-1.04 at n = 40. Smaller
+//   raster order 0.89-0.91 of Morton's time per step at n = 40 (64 000 particles) on one thread,
+//   0.91-0.96 on two, 0.90 at n = 56, 0.95-0.98 at n = 30; Hilbert 1.03-1.04 at n = 40. Smaller
 //   scenes keep the Morton order: in cache it makes little difference (0.97-0.98 at n = 22), and
 //   any other order changes the rounding of every sum, and with it the packings and calibrations
 //   made so far (the REV of materials.lua, 935 particles, packs differently: E 15 % off).
@@ -139,15 +139,15 @@ void reorder(State& s, const CellGrid& g) {
   const bool raster = n >= kRasterFrom;
   const std::array<int, 3> axis = raster_axes(g);
   const std::uint64_t count[3] = {std::uint64_t(g.nx), std::uint64_t(g.ny), std::uint64_t(g.nz)};
+  auto cell_code = [&](const std::uint64_t (&c)[3]) {
+    if (!raster) return spread_bits(c[0]) | spread_bits(c[1]) << 1 | spread_bits(c[2]) << 2;
+    return (c[axis[2]] * count[axis[1]] + c[axis[1]]) * count[axis[0]] + c[axis[0]];
+  };
   std::vector<std::uint64_t> code(n);
   for (std::size_t i = 0; i < n; ++i) {
-    int c[3];
-    g.coords(p.x[i], p.y[i], p.z[i], c[0], c[1], c[2]);
-    code[i] = raster ? (std::uint64_t(c[axis[2]]) * count[axis[1]] + std::uint64_t(c[axis[1]])) *
-                               count[axis[0]] +
-                           std::uint64_t(c[axis[0]])
-                     : spread_bits(std::uint64_t(c[0])) | spread_bits(std::uint64_t(c[1])) << 1 |
-                           spread_bits(std::uint64_t(c[2])) << 2;
+    int a, b, c;
+    g.coords(p.x[i], p.y[i], p.z[i], a, b, c);
+    code[i] = cell_code({std::uint64_t(a), std::uint64_t(b), std::uint64_t(c)});
   }
   std::vector<std::int32_t> order(n);
   std::iota(order.begin(), order.end(), 0);
