@@ -111,9 +111,11 @@ StageLoop bond_stage(State& s) {
   const auto args = bond_kernel_args(s);
   // A bonded particle does not rotate (model.md 5: its rotation is locked), so its angular
   // velocity is +0 unless a rotating rigid group carries it (or bonded rotation was unlocked).
-  // Then the kernel that takes w = +0 without reading it gives the same values, bit for bit
-  // (-0 counts as spinning: its sign could reach a result), and skips six loads and the spin
-  // terms: the joint's elastic step costs 6-18 % less (perf/README.md).
+  // Then the kernel that takes w = +0 without reading it gives the same values (-0 counts as
+  // spinning: its sign could reach a result; the law without spin differs from the full one at
+  // w = +0 only in the sign of an exact zero, bond_law.hpp). It skips six loads and every spin
+  // term of the law: the joint's elastic step costs 6-18 % less for the loads and another ~15 %
+  // for the terms (perf/README.md).
   bool spin = s.any_rotating;
   if (spin) {
     const ParticleStore& p = s.p;

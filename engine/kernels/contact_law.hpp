@@ -36,7 +36,11 @@ inline void small_sincos(const T& phi, T& s, T& c) {
 // (1) the rotation taking the old normal o onto the new normal n, applied to F:
 //     R F = c F + s x F + (s.F) s / (1 + c),  c = o.n, s = o x n  (Rodrigues, unnormalised axis);
 // (2) the rotation about n by the mean spin angle phi = 0.5 (wA + wB).n dt.
-template <class T>
+//
+// Spin = false: both bodies have w = +0, so phi = +-0, sin = +-0, cos = 1, and step (2) returns its
+// input (x * 1 + (+-0) + (+-0) = x for x != 0): it is skipped. Results can differ from Spin =
+// true only in the sign of an exact zero, which no later operation turns into a nonzero value.
+template <class T, bool Spin = true>
 inline void carry_shear(const T& ox, const T& oy, const T& oz, const T& nx, const T& ny,
                         const T& nz, const T& phi, T& fx, T& fy, T& fz) {
   const T c = ox * nx + oy * ny + oz * nz;
@@ -45,6 +49,12 @@ inline void carry_shear(const T& ox, const T& oy, const T& oz, const T& nx, cons
   const T rx = c * fx + (sy * fz - sz * fy) + sf * sx;
   const T ry = c * fy + (sz * fx - sx * fz) + sf * sy;
   const T rz = c * fz + (sx * fy - sy * fx) + sf * sz;
+  if constexpr (!Spin) {
+    fx = rx;
+    fy = ry;
+    fz = rz;
+    return;
+  }
   T sn, cs;
   small_sincos(phi, sn, cs);
   const T nr = (nx * rx + ny * ry + nz * rz) * (1.0 - cs);
@@ -57,7 +67,8 @@ inline void carry_shear(const T& ox, const T& oy, const T& oz, const T& nx, cons
 // la = |xc - xa|, lb = |xc - xb| (xc - xa = la n, xc - xb = -lb n). Gives the tangential
 // relative velocity Vs of b with respect to a at the contact point and the mean spin angle of the
 // step about n, phi = 0.5 (wA + wB).n dt (contact_forces).
-template <class T>
+// Spin = false: w = +0 on both sides, whose terms are left out (see carry_shear).
+template <class T, bool Spin = true>
 inline void contact_kinematics(const T& nx, const T& ny, const T& nz, const T& la, const T& lb,
                                const T& vax, const T& vay, const T& vaz, const T& wax,
                                const T& way, const T& waz, const T& vbx, const T& vby,
@@ -65,14 +76,18 @@ inline void contact_kinematics(const T& nx, const T& ny, const T& nz, const T& l
                                const T& dt, T& vsx, T& vsy, T& vsz, T& phi) {
   // Relative velocity of b with respect to a at the contact point [3-17, 3-18]:
   // V = (vB + wB x (xc - xB)) - (vA + wA x (xc - xA)) = vB - vA - lb (wB x n) - la (wA x n).
-  const T vx = (vbx - vax) - lb * (wby * nz - wbz * ny) - la * (way * nz - waz * ny);
-  const T vy = (vby - vay) - lb * (wbz * nx - wbx * nz) - la * (waz * nx - wax * nz);
-  const T vz = (vbz - vaz) - lb * (wbx * ny - wby * nx) - la * (wax * ny - way * nx);
+  T vx = vbx - vax, vy = vby - vay, vz = vbz - vaz;
+  phi = T(0.0);
+  if constexpr (Spin) {
+    vx = vx - lb * (wby * nz - wbz * ny) - la * (way * nz - waz * ny);
+    vy = vy - lb * (wbz * nx - wbx * nz) - la * (waz * nx - wax * nz);
+    vz = vz - lb * (wbx * ny - wby * nx) - la * (wax * ny - way * nx);
+    phi = 0.5 * dt * ((wax + wbx) * nx + (way + wby) * ny + (waz + wbz) * nz);
+  }
   const T vn = vx * nx + vy * ny + vz * nz;
   vsx = vx - vn * nx;
   vsy = vy - vn * ny;
   vsz = vz - vn * nz;
-  phi = 0.5 * dt * ((wax + wbx) * nx + (way + wby) * ny + (waz + wbz) * nz);
 }
 
 // Forces of one contact from its geometry (normal n, overlap U) and kinematics (Vs, phi:
@@ -80,13 +95,13 @@ inline void contact_kinematics(const T& nx, const T& ny, const T& nz, const T& l
 // > 0 for a contact left by a bond installed stress-free). On entry (o, F) hold the normal and
 // shear force of the previous step; on exit F is the new shear force on b and fn the normal
 // force on b. Returns the energy dissipated by slip in this step.
-template <class T>
+template <class T, bool Spin = true>
 inline T contact_response(const T& nx, const T& ny, const T& nz, const T& U, const T& vsx,
                           const T& vsy, const T& vsz, const T& phi, const T& ox, const T& oy,
                           const T& oz, const T& U0, T& fx, T& fy, T& fz, T& fn,
                           const LawParams<T>& p) {
   const auto touching = U > T(0.0);
-  carry_shear(ox, oy, oz, nx, ny, nz, phi, fx, fy, fz);
+  carry_shear<T, Spin>(ox, oy, oz, nx, ny, nz, phi, fx, fy, fz);
   // Incremental shear force [3-19..3-21]: dFs = -ks Vs dt.
   fx = fx - p.ks * vsx * p.dt;
   fy = fy - p.ks * vsy * p.dt;
