@@ -131,7 +131,7 @@ inline T contact_response(const T& nx, const T& ny, const T& nz, const T& U, con
 
 // Both in one: the contact law of model.md 4 for a contact whose geometry is known (normal n,
 // overlap U, lever arms la, lb), from the two bodies' velocities.
-template <class T>
+template <class T, bool Spin = true>
 inline T contact_forces(const T& nx, const T& ny, const T& nz, const T& U, const T& la,
                         const T& lb, const T& vax, const T& vay, const T& vaz, const T& wax,
                         const T& way, const T& waz, const T& vbx, const T& vby, const T& vbz,
@@ -139,9 +139,10 @@ inline T contact_forces(const T& nx, const T& ny, const T& nz, const T& U, const
                         const T& oz, const T& U0, T& fx, T& fy, T& fz, T& fn,
                         const LawParams<T>& p) {
   T vsx, vsy, vsz, phi;
-  contact_kinematics(nx, ny, nz, la, lb, vax, vay, vaz, wax, way, waz, vbx, vby, vbz, wbx, wby,
-                     wbz, p.dt, vsx, vsy, vsz, phi);
-  return contact_response(nx, ny, nz, U, vsx, vsy, vsz, phi, ox, oy, oz, U0, fx, fy, fz, fn, p);
+  contact_kinematics<T, Spin>(nx, ny, nz, la, lb, vax, vay, vaz, wax, way, waz, vbx, vby, vbz,
+                              wbx, wby, wbz, p.dt, vsx, vsy, vsz, phi);
+  return contact_response<T, Spin>(nx, ny, nz, U, vsx, vsy, vsz, phi, ox, oy, oz, U0, fx, fy, fz,
+                                   fn, p);
 }
 
 // Geometry of a ball-ball pair [3-10, 3-11].

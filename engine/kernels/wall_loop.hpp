@@ -40,7 +40,8 @@ void plane_wall_loop(const PlaneWallArgs& k, std::size_t begin, std::size_t end)
     const LawParams<T> law{Lanes::gather(k.kn, iw), Lanes::gather(k.ks, iw),
                            Lanes::gather(k.friction, iw), T(k.dt)};
     const T zero(0.0);
-    const T slip = contact_forces(nx, ny, nz, U, zero, lb, vax, vay, vaz, zero, zero, zero, vbx,
+    // Without rotation both sides have w = +0: the law without spin (contact_law.hpp).
+    const T slip = contact_forces<T, Rotation>(nx, ny, nz, U, zero, lb, vax, vay, vaz, zero, zero, zero, vbx,
                                   vby, vbz, wbx, wby, wbz, ox, oy, oz, zero, fx, fy, fz, fn, law);
     Lanes::store_u(k.nx + i, nx); Lanes::store_u(k.ny + i, ny); Lanes::store_u(k.nz + i, nz);
     Lanes::store_u(k.fsx + i, fx); Lanes::store_u(k.fsy + i, fy); Lanes::store_u(k.fsz + i, fz);
