@@ -93,6 +93,14 @@ TEST(Bonds, BendingStressIsFourMOverPiRCubed) {
   const double M = 0.1 * kR * kR / 4 * theta;  // kbn I theta with kbn A = beam_kn
   EXPECT_NEAR(norm(info[0].bending_moment), M, 1e-9 * M);
   EXPECT_NEAR(info[0].sigma, 4 * M / (std::numbers::pi * std::pow(kR, 3)), 1e-9 * info[0].sigma);
+  // The moment reaches the particles through the gather (store/bonds.hpp records):
+  // on a, -(Mbn n + Mbs) - (Ra - U/2) n x Fs.
+  const BondInfo& b = info[0];
+  const Vec3 expected = -(b.normal * b.twisting_moment + b.bending_moment) -
+                        (kR + 0.5 * b.gap) * cross(b.normal, b.shear_force);
+  const Vec3 got = p.w.torque(p.a);
+  EXPECT_GT(norm(b.bending_moment), 0.5 * norm(expected)) << "the moment dominates the torque";
+  EXPECT_NEAR(norm(got - expected), 0.0, 1e-9 * norm(expected));
 }
 
 TEST(Bonds, TwistingStressIsTwoTOverPiRCubed) {
