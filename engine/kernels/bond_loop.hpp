@@ -27,9 +27,9 @@ double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
     const T rsafe = select(real, rbeam, T(1.0));
     const T u0 = k.rest ? Lanes::load(k.rest + i) : T(0.0);
     T sigma, tau;
-    const T crit = bond_forces<T, Rotation>(nx, ny, nz, U, la, lb, rsafe, q.vax, q.vay, q.vaz, q.wax, q.way,
-                               q.waz, q.vbx, q.vby, q.vbz, q.wbx, q.wby, q.wbz, ox, oy, oz, u0, s,
-                               sigma, tau, p);
+    const T crit = bond_forces<T, Rotation>(nx, ny, nz, U, la, lb, rsafe, q.vax, q.vay, q.vaz,
+                                            q.wax, q.way, q.waz, q.vbx, q.vby, q.vbz, q.wbx, q.wby,
+                                            q.wbz, ox, oy, oz, u0, s, sigma, tau, p);
     T brk(0.0);
     if (breakable) {
       brk = select(real & (crit >= T(1.0)), T(1.0), T(0.0));

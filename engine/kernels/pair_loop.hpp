@@ -33,8 +33,9 @@ double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
       T nx, ny, nz, U, la, lb;
       ball_ball_geometry(q.xa, q.ya, q.za, q.xb, q.yb, q.zb, q.ra, q.rb, nx, ny, nz, U, la, lb);
       T vsx, vsy, vsz, phi;
-      contact_kinematics<T, Rotation>(nx, ny, nz, la, lb, q.vax, q.vay, q.vaz, q.wax, q.way, q.waz, q.vbx,
-                         q.vby, q.vbz, q.wbx, q.wby, q.wbz, p.dt, vsx, vsy, vsz, phi);
+      contact_kinematics<T, Rotation>(nx, ny, nz, la, lb, q.vax, q.vay, q.vaz, q.wax, q.way,
+                                      q.waz, q.vbx, q.vby, q.vbz, q.wbx, q.wby, q.wbz, p.dt, vsx,
+                                      vsy, vsz, phi);
       Lanes::store(scratch[0] + j, nx); Lanes::store(scratch[1] + j, ny);
       Lanes::store(scratch[2] + j, nz); Lanes::store(scratch[3] + j, U);
       Lanes::store(scratch[4] + j, vsx); Lanes::store(scratch[5] + j, vsy);
@@ -48,11 +49,10 @@ double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
       T fx = Lanes::load(k.fsx + i), fy = Lanes::load(k.fsy + i), fz = Lanes::load(k.fsz + i);
       const T u0 = k.rest ? Lanes::load(k.rest + i) : T(0.0);
       T fn;
-      slip_sum = slip_sum + contact_response<T, Rotation>(nx, ny, nz, U, Lanes::load(scratch[4] + j),
-                                             Lanes::load(scratch[5] + j),
-                                             Lanes::load(scratch[6] + j),
-                                             Lanes::load(scratch[7] + j), ox, oy, oz, u0, fx,
-                                             fy, fz, fn, p);
+      slip_sum = slip_sum + contact_response<T, Rotation>(
+                                nx, ny, nz, U, Lanes::load(scratch[4] + j),
+                                Lanes::load(scratch[5] + j), Lanes::load(scratch[6] + j),
+                                Lanes::load(scratch[7] + j), ox, oy, oz, u0, fx, fy, fz, fn, p);
       // A pair that no longer touches forgets its rest overlap with its shear force.
       if (k.rest) Lanes::store(k.rest + i, select(U > T(0.0), u0, T(0.0)));
       Lanes::store(k.nx + i, nx); Lanes::store(k.ny + i, ny); Lanes::store(k.nz + i, nz);

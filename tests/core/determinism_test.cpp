@@ -209,7 +209,8 @@ TEST(Determinism, PairKernelWithoutSpinIsTheFullLawAtZeroSpin) {
         for (auto c : {&RandomPairs::nx, &RandomPairs::fsx, &RandomPairs::fsy, &RandomPairs::fsz})
           EXPECT_EQ(0, std::memcmp((full.*c).data(), (cut.*c).data(), pairs * sizeof(double))) << what;
       } else {
-        for (std::size_t j = 0; j < 8 * pairs; ++j) ASSERT_EQ(full.out[j], cut.out[j]) << what << " slot " << j;
+        for (std::size_t j = 0; j < 8 * pairs; ++j)
+          ASSERT_EQ(full.out[j], cut.out[j]) << what << " slot " << j;
         for (std::size_t k = 0; k < pairs; ++k) {
           ASSERT_EQ(full.fsx[k], cut.fsx[k]) << what << " pair " << k;
           ASSERT_EQ(full.fsy[k], cut.fsy[k]) << what << " pair " << k;
