@@ -114,8 +114,8 @@ StageLoop bond_stage(State& s) {
   // Then the kernel that takes w = +0 without reading it gives the same values (-0 counts as
   // spinning: its sign could reach a result; the law without spin differs from the full one at
   // w = +0 only in the sign of an exact zero, bond_law.hpp). It skips six loads and every spin
-  // term of the law: the joint's elastic step costs 6-18 % less for the loads and another ~15 %
-  // for the terms (perf/README.md).
+  // term of the law: the joint's elastic step on one thread costs 6-18 % less for the loads and
+  // another 6-22 % for the terms; on two threads the latter did not show (perf/README.md).
   bool spin = s.any_rotating;
   if (spin) {
     const ParticleStore& p = s.p;

@@ -63,17 +63,17 @@ inline void carry_shear(const T& ox, const T& oy, const T& oz, const T& nx, cons
   fz = rz * cs + (nx * ry - ny * rx) * sn + nz * nr;
 }
 
-// Kinematics of one contact whose geometry is known: normal n (from a to b), lever arms
-// la = |xc - xa|, lb = |xc - xb| (xc - xa = la n, xc - xb = -lb n). Gives the tangential
-// relative velocity Vs of b with respect to a at the contact point and the mean spin angle of the
-// step about n, phi = 0.5 (wA + wB).n dt (contact_forces).
+// Kinematics of one contact or bond whose geometry is known: normal n (from a to b), lever arms
+// la = |xc - xa|, lb = |xc - xb| (xc - xa = la n, xc - xb = -lb n). Gives the normal and
+// tangential relative velocity vn, Vs of b with respect to a at the contact point and the mean
+// spin angle of the step about n, phi = 0.5 (wA + wB).n dt (contact_forces, bond_forces).
 // Spin = false: w = +0 on both sides, whose terms are left out (see carry_shear).
 template <class T, bool Spin = true>
 inline void contact_kinematics(const T& nx, const T& ny, const T& nz, const T& la, const T& lb,
                                const T& vax, const T& vay, const T& vaz, const T& wax,
                                const T& way, const T& waz, const T& vbx, const T& vby,
                                const T& vbz, const T& wbx, const T& wby, const T& wbz,
-                               const T& dt, T& vsx, T& vsy, T& vsz, T& phi) {
+                               const T& dt, T& vn, T& vsx, T& vsy, T& vsz, T& phi) {
   // Relative velocity of b with respect to a at the contact point [3-17, 3-18]:
   // V = (vB + wB x (xc - xB)) - (vA + wA x (xc - xA)) = vB - vA - lb (wB x n) - la (wA x n).
   T vx = vbx - vax, vy = vby - vay, vz = vbz - vaz;
@@ -84,7 +84,7 @@ inline void contact_kinematics(const T& nx, const T& ny, const T& nz, const T& l
     vz = vz - lb * (wbx * ny - wby * nx) - la * (wax * ny - way * nx);
     phi = 0.5 * dt * ((wax + wbx) * nx + (way + wby) * ny + (waz + wbz) * nz);
   }
-  const T vn = vx * nx + vy * ny + vz * nz;
+  vn = vx * nx + vy * ny + vz * nz;
   vsx = vx - vn * nx;
   vsy = vy - vn * ny;
   vsz = vz - vn * nz;
@@ -138,9 +138,9 @@ inline T contact_forces(const T& nx, const T& ny, const T& nz, const T& U, const
                         const T& wbx, const T& wby, const T& wbz, const T& ox, const T& oy,
                         const T& oz, const T& U0, T& fx, T& fy, T& fz, T& fn,
                         const LawParams<T>& p) {
-  T vsx, vsy, vsz, phi;
+  T vn, vsx, vsy, vsz, phi;
   contact_kinematics<T, Spin>(nx, ny, nz, la, lb, vax, vay, vaz, wax, way, waz, vbx, vby, vbz,
-                              wbx, wby, wbz, p.dt, vsx, vsy, vsz, phi);
+                              wbx, wby, wbz, p.dt, vn, vsx, vsy, vsz, phi);
   return contact_response<T, Spin>(nx, ny, nz, U, vsx, vsy, vsz, phi, ox, oy, oz, U0, fx, fy, fz,
                                    fn, p);
 }

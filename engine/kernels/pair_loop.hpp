@@ -32,10 +32,10 @@ double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
       const BatchSides<T> q = load_sides<Lanes, Rotation>(k, i);
       T nx, ny, nz, U, la, lb;
       ball_ball_geometry(q.xa, q.ya, q.za, q.xb, q.yb, q.zb, q.ra, q.rb, nx, ny, nz, U, la, lb);
-      T vsx, vsy, vsz, phi;
+      T vn, vsx, vsy, vsz, phi;
       contact_kinematics<T, Rotation>(nx, ny, nz, la, lb, q.vax, q.vay, q.vaz, q.wax, q.way,
-                                      q.waz, q.vbx, q.vby, q.vbz, q.wbx, q.wby, q.wbz, p.dt, vsx,
-                                      vsy, vsz, phi);
+                                      q.waz, q.vbx, q.vby, q.vbz, q.wbx, q.wby, q.wbz, p.dt, vn,
+                                      vsx, vsy, vsz, phi);
       Lanes::store(scratch[0] + j, nx); Lanes::store(scratch[1] + j, ny);
       Lanes::store(scratch[2] + j, nz); Lanes::store(scratch[3] + j, U);
       Lanes::store(scratch[4] + j, vsx); Lanes::store(scratch[5] + j, vsy);
