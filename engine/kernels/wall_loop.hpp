@@ -41,8 +41,9 @@ void plane_wall_loop(const PlaneWallArgs& k, std::size_t begin, std::size_t end)
                            Lanes::gather(k.friction, iw), T(k.dt)};
     const T zero(0.0);
     // Without rotation both sides have w = +0: the law without spin (contact_law.hpp).
-    const T slip = contact_forces<T, Rotation>(nx, ny, nz, U, zero, lb, vax, vay, vaz, zero, zero, zero, vbx,
-                                  vby, vbz, wbx, wby, wbz, ox, oy, oz, zero, fx, fy, fz, fn, law);
+    const T slip = contact_forces<T, Rotation>(nx, ny, nz, U, zero, lb, vax, vay, vaz, zero, zero,
+                                               zero, vbx, vby, vbz, wbx, wby, wbz, ox, oy, oz, zero,
+                                               fx, fy, fz, fn, law);
     Lanes::store_u(k.nx + i, nx); Lanes::store_u(k.ny + i, ny); Lanes::store_u(k.nz + i, nz);
     Lanes::store_u(k.fsx + i, fx); Lanes::store_u(k.fsy + i, fy); Lanes::store_u(k.fsz + i, fz);
     Lanes::store_u(k.fn + i, fn);

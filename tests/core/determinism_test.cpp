@@ -206,7 +206,8 @@ TEST(Determinism, PairKernelWithoutSpinIsTheFullLawAtZeroSpin) {
       EXPECT_EQ(slip_full, slip_cut) << what;
       if (!still) {
         EXPECT_EQ(0, std::memcmp(full.out.data(), cut.out.data(), 8 * pairs * sizeof(double))) << what;
-        for (auto c : {&RandomPairs::nx, &RandomPairs::fsx, &RandomPairs::fsy, &RandomPairs::fsz})
+        for (auto c : {&RandomPairs::nx, &RandomPairs::ny, &RandomPairs::nz, &RandomPairs::fsx,
+                       &RandomPairs::fsy, &RandomPairs::fsz})
           EXPECT_EQ(0, std::memcmp((full.*c).data(), (cut.*c).data(), pairs * sizeof(double))) << what;
       } else {
         for (std::size_t j = 0; j < 8 * pairs; ++j)
