@@ -107,6 +107,15 @@ local function make_packing()
                                       target = P.packing_stress, ratio = P.ratio})
     log("stress installation: radii x %.5f, wall stress %.4g Pa (target %.4g) after %d iterations",
         s.factor, s.stress, P.packing_stress, s.iterations)
+    -- Near jamming the stress is not a continuous function of the radii: a packing that came
+    -- unjammed by a shrink does not jam again at the same density (its rattlers moved), so the
+    -- bisection can close on the jump with the target unmet. The REV is then bonded as it is
+    -- (with the stress it carries, possibly none); say so rather than pass it silently.
+    if not s.reached then
+      log("warning: the stress installation did not reach %.4g Pa (it ended at %.4g Pa): the bonds " ..
+          "are installed in that state (summary.json: stress_installation.reached = false)",
+          P.packing_stress, s.stress)
+    end
     info.stress_installation = s
   end
   local rr = w:radii():flat()
@@ -420,6 +429,7 @@ local summary = {
   packing_steps = packing.expansion.steps, packing_stress_target_pa = P.packing_stress,
   stress_free_bonds = P.stress_free_bonds,
   radius_factor_stress_installation = packing.stress_installation and packing.stress_installation.factor or 1,
+  stress_installation = packing.stress_installation,  -- {factor, stress, iterations, steps, reached}
   bonds = elastic_info.bonds, bonds_per_particle = 2 * elastic_info.bonds / packing.n_particles,
   residual_bond_stress = residual,
   young_modulus_pa = E, poisson_ratio = nu,
