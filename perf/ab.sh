@@ -6,6 +6,7 @@
 #
 #   perf/ab.sh A B [n=40] [rounds=30] [steps=10] [warmup=200] [threads=1]
 #   ASPERITY_AB_BONDED=1 perf/ab.sh A B ...     # the lattice bonded (the bond kernel's scene)
+#   ASPERITY_AB_WORLD=FILE perf/ab.sh A B ...   # a saved world, e.g. the joint in mid-shear (perf/README.md)
 #
 # A, B: source trees (directories) or git revisions of this repository, checked out as detached
 # worktrees under ${TMPDIR:-/tmp}/asperity-ab/. Each is built in <tree>/build-ab (Release,
@@ -16,7 +17,7 @@
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 if [ $# -lt 2 ]; then
-  sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//' >&2
+  sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//' >&2
   exit 2
 fi
 

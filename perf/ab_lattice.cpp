@@ -3,6 +3,8 @@
 //   build/perf/ab_lattice A/libasperity_ab.so B/libasperity_ab.so n=40 rounds=30 steps=10
 //   build/perf/ab_lattice A.so A.so n=22 nb=100   # one build, cost per particle-step against size
 //   build/perf/ab_lattice A.so A.so n=30 bonded_b=1   # one build, the bonded block against the lattice
+//   ASPERITY_AB_WORLD=out/joint_state.h5 build/perf/ab_lattice A.so B.so threads=2 warmup=50
+//                                         # a saved world instead of the lattice (the joint's shear)
 //
 // Both modules build the scene; then `rounds` times each runs `steps` steps, in alternating order,
 // each timed on the wall clock. Printed: per build the best and median ns per particle-step, the
@@ -104,6 +106,12 @@ int main(int argc, char** argv) {
   // nb != n (the same build twice, say): cost per particle-step against size in one process; B
   // runs about as many particle-steps per round as A.
   const double particles[2] = {double(m[0].particles(m[0].run)), double(m[1].particles(m[1].run))};
+  // A module older than ASPERITY_AB_WORLD builds the lattice instead: refuse to compare the two.
+  if (nb == n && !bonded_b && particles[0] != particles[1]) {
+    std::fprintf(stderr, "ab_lattice: the two modules made different scenes (%.0f and %.0f particles): "
+                 "does each know ASPERITY_AB_WORLD?\n", particles[0], particles[1]);
+    return 2;
+  }
   const long count[2] = {steps, std::max(1L, long(double(steps) * particles[0] / particles[1] + 0.5))};
   std::vector<double> t[2], ratio;
   using Clock = std::chrono::steady_clock;
@@ -118,8 +126,13 @@ int main(int argc, char** argv) {
     }
     ratio.push_back(s[1] / s[0]);
   }
-  std::printf("lattice n=%ld, %.0f particles, %ld rounds of %ld steps, %ld thread(s)\n", n,
-              particles[0], rounds, steps, threads);
+  const char* world = std::getenv("ASPERITY_AB_WORLD");
+  if (world && *world)
+    std::printf("world %s, %.0f particles, %ld rounds of %ld steps, %ld thread(s)\n", world,
+                particles[0], rounds, steps, threads);
+  else
+    std::printf("lattice n=%ld, %.0f particles, %ld rounds of %ld steps, %ld thread(s)\n", n,
+                particles[0], rounds, steps, threads);
   if (nb != n || bonded_b)
     std::printf("B: lattice n=%ld%s, %.0f particles, %ld steps a round\n", nb, bonded_b ? " bonded" : "",
                 particles[1], count[1]);

@@ -22,7 +22,11 @@ extern "C" {
 
 // ASPERITY_AB_BONDED=1 in the environment: every touching pair bonded, unbreakable, as
 // `perf/lattice.lua bonded=true` (the bond kernel's scene), with the automatic time step.
+// ASPERITY_AB_WORLD=FILE: instead of the lattice, the world of a checkpoint (say the joint in
+// mid-shear, `scripts/joint.lua shear=0.1 save=FILE`), which continues as the saved run would.
 __attribute__((visibility("default"))) void* asperity_ab_make(int n, int threads) {
+  if (const char* file = std::getenv("ASPERITY_AB_WORLD"); file && *file)
+    return new Run{asperity::World::load(file, threads)};
   asperity::perf::LatticeOptions o;
   o.n = n;
   o.threads = threads;

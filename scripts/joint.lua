@@ -74,6 +74,8 @@ local P = require("params").defaults{
   simd = "auto",           -- kernels of closure and shear: auto, an architecture, or "float" (the force laws
                            -- in single precision, scalar: perf/runtime_vs_error.lua's study); packing: auto
   progress = true,
+  save = "",               -- a path: the world's checkpoint when the shear ends (to continue from it,
+                           -- or to time the shear step in one process: perf/README.md, perf/ab.sh)
 }
 if P.scale == "thesis" then
   if params.size == nil then P.size = 0.1 end
@@ -541,6 +543,10 @@ world:run{steps = 100000000, every = record_every, progress = P.progress,
           end}
 world:run{steps = 100000000, every = 1, stop_when = function() return displacement() >= P.shear end}
 record_shear()
+if P.save ~= "" then
+  world:save(P.save)
+  log("saved the world at %.3f mm of shear to %s", displacement(), P.save)
+end
 local shear_seconds, shear_steps = asperity.wall_time() - shear_t0, world:step() - shear_s0
 local shear_rebuilds = world:stats().rebuilds - shear_r0
 shear:write(P.out .. "/shear")
