@@ -3,6 +3,10 @@
 #include <immintrin.h>
 #endif
 
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+
 #include "state.hpp"
 
 namespace asperity::detail {
@@ -18,6 +22,34 @@ kernels::PairKernelArgs pair_kernel_args(State& s) {
           s.rest_overlaps ? q.rest.data() : nullptr};
 }
 
+namespace {
+
+// Whether some particle the pair list can reach has an angular velocity other than +0. Rotation
+// being possible (any_rotating) does not mean anything turns: in the joint every particle of a
+// pair is bonded (rotation locked, model.md 5) or a member of a platen that does not rotate, and
+// only the inert ones left out after packing, which no pair reaches, keep a spin. Where nothing
+// spins, the law without its spin terms gives the full law's values except for the sign of an
+// exact zero (contact_law.hpp). Chunks of 256 particles, so the scan vectorises and still stops
+// soon where things do turn (the lattice).
+bool pairs_can_spin(const State& s) {
+  if (!s.any_rotating) return false;
+  const ParticleStore& p = s.p;
+  const double *wx = p.wx.data(), *wy = p.wy.data(), *wz = p.wz.data();
+  const std::uint8_t* inert = p.inert.data();
+  auto bits = [](double w) { return std::bit_cast<std::uint64_t>(w); };  // 0: exactly +0
+  constexpr std::size_t chunk = 256;
+  for (std::size_t first = 0; first < p.n; first += chunk) {
+    const std::size_t end = std::min(p.n, first + chunk);
+    std::uint64_t any = 0;
+    for (std::size_t i = first; i < end; ++i)
+      any |= (bits(wx[i]) | bits(wy[i]) | bits(wz[i])) & (std::uint64_t(0) - std::uint64_t(inert[i] == 0));
+    if (any) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 StageLoop pair_stage(State& s) {
   auto args = pair_kernel_args(s);
   // Records past the caches are written with non-temporal stores: the gather reads them out of
@@ -25,7 +57,7 @@ StageLoop pair_stage(State& s) {
   // ownership first. AVX2 machine of perf/README.md, in one process: lattice n = 40 0.91-0.96 on
   // one thread, 0.86-0.91 on two; n = 46 0.90. In cache it would cost (n = 22: 1.16).
   args.stream = records_past_caches(s.pairs.out);
-  const auto kernel = s.any_rotating ? s.kernels->pair : s.kernels->pair_norot;
+  const auto kernel = pairs_can_spin(s) ? s.kernels->pair : s.kernels->pair_norot;
   const std::size_t total = s.pairs.padded;
   s.pairs.outputs_in_records = true;  // the kernel writes fn and U to the records only
   StageLoop st;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "asperity/world.hpp"
 #include "core/report.hpp"
@@ -91,4 +92,38 @@ TEST(Friction, SetFrictionChangesTheBallBallSlipLimit) {
   EXPECT_NEAR(fs, 0.1 * c[0].normal_force, 1e-12 * kN) << "sliding at the new limit";
   EXPECT_GT(w.velocity(b).x, 0.0);
   EXPECT_GT(w.energies().friction, 0.0);
+}
+
+TEST(Friction, ASpinningSphereShearsItsContactInTheFirstStep) {
+  // The pair stage leaves the spin terms out when no particle a pair can reach turns
+  // (kernels/pairs.cpp); a spin set through the API must still drive the law's relative velocity
+  // at once: A turns about x at w, B rests on it along z, so at the contact point
+  // V = -la (wA x n) = (0, la w, 0) and the first step's shear force on B is -ks V dt [3-19].
+  // An inert spinning particle far away (never in a pair) must not matter either way.
+  for (bool bystander : {false, true}) {
+    WorldSettings ws;
+    ws.contact = {1e3, 2e2, 0.5};
+    ws.reorder_interval = 0;
+    World w(ws);
+    const double R = 5e-4, U = 1e-5, omega = 0.3;
+    const auto a = w.add_particle({0, 0, 0}, R);
+    w.add_particle({0, 0, 2 * R - U}, R);
+    if (bystander) {
+      const auto far = w.add_particle({0.1, 0.1, 0.1}, R);
+      w.set_angular_velocity(far, {1, 2, 3});
+      const std::vector<std::int64_t> ids{far};
+      w.add_group(ids);  // inert particles belong to a rigid body
+      w.set_inert(ids);
+    }
+    w.set_angular_velocity(a, {omega, 0, 0});
+    const double dt = w.critical_dt() / 10;
+    w.set_dt(dt);
+    w.cycle(1);
+    const auto c = w.contacts();
+    ASSERT_EQ(c.size(), 1u);
+    const double la = R - 0.5 * U;
+    EXPECT_NEAR(c[0].shear_force.y, -ws.contact.ks * (la * omega) * dt, 1e-12 * ws.contact.ks * la * omega * dt)
+        << (bystander ? "with" : "without") << " an inert spinning particle";
+    EXPECT_EQ(c[0].shear_force.x, 0.0);
+  }
 }
