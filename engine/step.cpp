@@ -317,7 +317,8 @@ void run_stages(State& s, std::initializer_list<StageLoop*> stages) {
     BlockRange* const r = ranges.get();
 #pragma omp parallel num_threads(threads)
     {
-      // The runtime may give fewer threads than asked: their shares are taken by the others.
+      // The runtime may give fewer threads than asked: the shares of the missing ones are taken
+      // by the others.
       const int t = omp_get_thread_num();
       std::size_t base = 0;
       for (StageLoop* st : stages) {
@@ -327,8 +328,7 @@ void run_stages(State& s, std::initializer_list<StageLoop*> stages) {
         BlockRange* share = r + base;
         base += std::size_t(threads);
         std::size_t blk;
-        if (t < threads)
-          while (share[t].take<false>(blk)) st->run(blk);
+        while (share[t].take<false>(blk)) st->run(blk);
         for (int k = 1; k < threads; ++k)
           while (share[(t + k) % threads].take<true>(blk)) st->run(blk);
       }

@@ -2,7 +2,6 @@
 // bookkeeping, the breaks: an event each, the released strain energy, the contact a broken bond
 // leaves behind, compaction of the list and the rotation locks.
 #include <algorithm>
-#include <bit>
 #include <cmath>
 
 #include "kernels/bond_law.hpp"
@@ -120,9 +119,8 @@ StageLoop bond_stage(State& s) {
   if (spin) {
     const ParticleStore& p = s.p;
     spin = false;
-    auto bits = [](double w) { return std::bit_cast<std::uint64_t>(w); };  // 0: exactly +0
     for (const std::int32_t i : s.bonded_particles)
-      if (bits(p.wx[i]) | bits(p.wy[i]) | bits(p.wz[i])) {
+      if (p.spin_bits(std::size_t(i))) {
         spin = true;
         break;
       }

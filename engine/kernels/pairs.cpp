@@ -4,7 +4,6 @@
 #endif
 
 #include <algorithm>
-#include <bit>
 #include <cstdint>
 
 #include "state.hpp"
@@ -34,15 +33,13 @@ namespace {
 bool pairs_can_spin(const State& s) {
   if (!s.any_rotating) return false;
   const ParticleStore& p = s.p;
-  const double *wx = p.wx.data(), *wy = p.wy.data(), *wz = p.wz.data();
   const std::uint8_t* inert = p.inert.data();
-  auto bits = [](double w) { return std::bit_cast<std::uint64_t>(w); };  // 0: exactly +0
   constexpr std::size_t chunk = 256;
   for (std::size_t first = 0; first < p.n; first += chunk) {
     const std::size_t end = std::min(p.n, first + chunk);
     std::uint64_t any = 0;
     for (std::size_t i = first; i < end; ++i)
-      any |= (bits(wx[i]) | bits(wy[i]) | bits(wz[i])) & (std::uint64_t(0) - std::uint64_t(inert[i] == 0));
+      any |= p.spin_bits(i) & (std::uint64_t(0) - std::uint64_t(inert[i] == 0));
     if (any) return true;
   }
   return false;

@@ -5,6 +5,7 @@
 // ones: radius 0, zero inverse mass, parked far apart on the x axis. Padding pairs of the pair
 // list point at two of them, so their overlap is negative and every force is zero.
 #pragma once
+#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -42,6 +43,13 @@ struct ParticleStore {
   void resize(std::size_t new_n);
   // Reorder every column by `order` (new index i holds old index order[i]).
   void permute(const std::vector<std::int32_t>& order);
+  // Nonzero unless particle i's angular velocity is exactly +0 on every axis (a -0 counts as
+  // turning: its sign could reach a result). The kernels without spin terms are exact only for
+  // +0 (kernels/contact_law.hpp); the pair and bond stages test this to choose them.
+  std::uint64_t spin_bits(std::size_t i) const {
+    return std::bit_cast<std::uint64_t>(wx[i]) | std::bit_cast<std::uint64_t>(wy[i]) |
+           std::bit_cast<std::uint64_t>(wz[i]);
+  }
 };
 
 }  // namespace asperity::detail
