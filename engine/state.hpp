@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "asperity/world.hpp"
+#include "core/load.hpp"
 #include "kernels/kernels.hpp"
 #include "store/bonds.hpp"
 #include "store/pairs.hpp"
@@ -94,6 +95,10 @@ struct State {
   bool rest_overlaps = false;
   const kernels::KernelSet* kernels = nullptr;
   int max_threads = 1;
+  // Automatic threads (settings.threads = 0): the cores other processes leave free, sampled every
+  // half second for the whole process (core/load.hpp, watch_load in step.cpp); 0: not known.
+  LoadWatch* load = &process_load();
+  int load_limit = 0;
 
   double dt = 0;             // in use
   double dt_estimate = 0;    // last critical estimate (no safety factor)
@@ -173,6 +178,7 @@ void advance_groups(State& s);          // bodies/groups.cpp
 double estimate_critical_dt(const State& s);  // step.cpp
 Energies compute_energies(const State& s);    // step.cpp
 void step_once(State& s);               // step.cpp
+void watch_load(State& s);              // step.cpp: State::load_limit, for automatic threads
 void update_servo_stiffness(State& s);  // bodies/groups.cpp: every step while a servo acts
 void sync_lazy(State& s);               // bodies/groups.cpp: bring inert and idle members up to date
 void split_idle(State& s);              // bodies/groups.cpp: busy / idle members of lazy groups
@@ -193,11 +199,14 @@ void query_mesh(const Mesh& mesh, const Vec3& q, double reach, std::vector<std::
 // loaded machine a spinning thread makes a small scene many times slower. Measured on two cores
 // (perf/README.md, "Threads"): the default elastic joint (4 031 pairs, 9 098 bonds) gains from a
 // second thread; its rigid twin (161 pairs) loses. The results do not depend on the count.
+// Also no more than the cores that other processes leave free (State::load_limit): a thread that
+// shares its core with a busy process holds the others up at every barrier.
 inline int thread_count(const State& s) {
   if (s.settings.threads > 0) return s.settings.threads;
   const std::size_t work = s.pairs.n + 2 * s.bonds.n;
   const std::size_t extra = std::max(work / 10000, s.p.n / 20000);
-  return std::clamp(int(std::min<std::size_t>(extra, 1024)) + 1, 1, s.max_threads);
+  const int cores = s.load_limit > 0 ? std::min(s.max_threads, s.load_limit) : s.max_threads;
+  return std::clamp(int(std::min<std::size_t>(extra, 1024)) + 1, 1, std::max(1, cores));
 }
 
 }  // namespace asperity::detail

@@ -338,7 +338,13 @@ void run_stages(State& s, std::initializer_list<StageLoop*> stages) {
     if (st->finish) st->finish();
 }
 
+void watch_load(State& s) {
+  if (s.settings.threads > 0 || s.max_threads <= 1) return;  // fixed, or nothing to choose
+  s.load_limit = s.load->limit(LoadWatch::now());             // a clock read; a sample each 0.5 s
+}
+
 void step_once(State& s) {
+  watch_load(s);
   const bool rebuilt = s.need_rebuild;
   if (rebuilt) build_neighbors(s);
   const bool estimate_due = s.step >= s.last_estimate_step + std::uint64_t(s.settings.dt_interval);

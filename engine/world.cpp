@@ -109,6 +109,9 @@ World::World(WorldSettings settings) : state_(std::make_unique<State>()) {
   require_finite(settings.gravity, "gravity");
   s.kernels = &kernels::select_kernels(settings.simd);
   s.max_threads = omp_get_max_threads();
+  // The first reading of the machine's load, so that the automatic thread count knows it by the
+  // time the scene is built and stepping starts (core/load.hpp).
+  if (settings.threads == 0 && s.max_threads > 1) s.load->limit(detail::LoadWatch::now());
   s.settings = settings;
   s.dt_fixed = settings.dt > 0;
   s.dt = settings.dt;
@@ -781,6 +784,8 @@ StepStats World::stats() const {
   st.pairs = s.pairs.n;
   st.contacts = contact_count();
   for (std::size_t k = 0; k < s.walls.contacts.n; ++k) st.wall_contacts += s.walls.contacts.overlap[k] > 0;
+  st.threads = detail::thread_count(s);
+  st.busy_elsewhere = s.settings.threads > 0 ? -1.0 : s.load->others();
   return st;
 }
 void World::rebuild_neighbors() {

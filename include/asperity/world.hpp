@@ -54,7 +54,8 @@ struct WorldSettings {
   bool allow_dt_above_estimate = false;  // a fixed dt above the estimate is an error unless set
   int dt_interval = 100;            // steps between critical-step estimates (also at each rebuild)
   int threads = 0;                  // OpenMP threads; 0: automatic (1 per 10 000 pairs or 5 000
-                                    // bonds, or per 20 000 particles, up to the cores available)
+                                    // bonds, or per 20 000 particles, up to the cores available
+                                    // and not kept busy by other processes, sampled every 0.5 s)
   std::string simd = "auto";        // "auto", "scalar", "sse4_2", "avx2", "avx512f"
   bool track_energy = true;         // friction, damping and boundary work ledgers (model.md 8)
   int reorder_interval = 10;        // neighbour rebuilds between reorders by cell; 0: never
@@ -156,6 +157,9 @@ struct StepStats {
   std::size_t pairs = 0;       // pairs in the neighbour list (touching or not)
   std::size_t contacts = 0;    // touching ball-ball pairs
   std::size_t wall_contacts = 0;
+  int threads = 1;                 // threads the next step runs on
+  double busy_elsewhere = -1;      // cores other processes kept busy lately (automatic threads
+                                   // only; -1: not measured), which the automatic count leaves
 };
 
 class World {
