@@ -109,10 +109,10 @@ World::World(WorldSettings settings) : state_(std::make_unique<State>()) {
   require_finite(settings.gravity, "gravity");
   s.kernels = &kernels::select_kernels(settings.simd);
   s.max_threads = omp_get_max_threads();
+  s.settings = settings;
   // The first reading of the machine's load, so that the automatic thread count knows it by the
   // time the scene is built and stepping starts (core/load.hpp).
-  if (settings.threads == 0 && s.max_threads > 1) s.load->limit(detail::LoadWatch::now());
-  s.settings = settings;
+  detail::watch_load(s);
   s.dt_fixed = settings.dt > 0;
   s.dt = settings.dt;
   s.p.resize(0);
