@@ -3,6 +3,7 @@
 //   build/perf/ab_lattice A/libasperity_ab.so B/libasperity_ab.so n=40 rounds=30 steps=10
 //   build/perf/ab_lattice A.so A.so n=22 nb=100   # one build, cost per particle-step against size
 //   build/perf/ab_lattice A.so A.so n=30 bonded_b=1   # one build, the bonded block against the lattice
+//   build/perf/ab_lattice A.so A.so threads=1 threads_b=2   # one build, 1 -> 2 threads in one process
 //   ASPERITY_AB_WORLD=out/joint_state.h5 build/perf/ab_lattice A.so B.so threads=2 warmup=50
 //                                         # a saved world instead of the lattice (the joint's shear)
 //
@@ -59,7 +60,7 @@ Module load(const char* path) {
 [[noreturn]] void usage(const char* why) {
   std::fprintf(stderr,
                "ab_lattice: %s\nusage: ab_lattice A.so B.so [n=40] [nb=n] [rounds=30] [steps=10] "
-               "[warmup=200] [threads=1] [bonded_b=0]\n",
+               "[warmup=200] [threads=1] [threads_b=threads] [bonded_b=0]\n",
                why);
   std::exit(2);
 }
@@ -74,7 +75,7 @@ double median(std::vector<double> v) {
 
 int main(int argc, char** argv) {
   if (argc < 3) usage("two modules are needed");
-  long n = 40, nb = 0, rounds = 30, steps = 10, warmup = 200, threads = 1, bonded_b = 0;
+  long n = 40, nb = 0, rounds = 30, steps = 10, warmup = 200, threads = 1, threads_b = 0, bonded_b = 0;
   for (int i = 3; i < argc; ++i) {
     const char* eq = std::strchr(argv[i], '=');
     if (!eq) usage((std::string("expected key=value, got ") + argv[i]).c_str());
@@ -88,10 +89,12 @@ int main(int argc, char** argv) {
     else if (key == "steps") steps = v;
     else if (key == "warmup") warmup = v;
     else if (key == "threads") threads = v;
+    else if (key == "threads_b") threads_b = v;
     else if (key == "bonded_b") bonded_b = v;
     else usage((std::string("unknown key ") + key).c_str());
   }
   if (nb == 0) nb = n;
+  if (threads_b == 0) threads_b = threads;
   Module m[2] = {load(argv[1]), load(argv[2])};
   for (int v = 0; v < 2; ++v) {
     // bonded_b=1: A the plain lattice, B bonded (ab_module.cpp reads the variable when it makes
@@ -100,7 +103,7 @@ int main(int argc, char** argv) {
       if (v == 1) setenv("ASPERITY_AB_BONDED", "1", 1);
       else unsetenv("ASPERITY_AB_BONDED");
     }
-    m[v].run = m[v].make(int(v ? nb : n), int(threads));
+    m[v].run = m[v].make(int(v ? nb : n), int(v ? threads_b : threads));
     m[v].cycle(m[v].run, warmup);
   }
   // nb != n (the same build twice, say): cost per particle-step against size in one process; B
@@ -133,6 +136,9 @@ int main(int argc, char** argv) {
   else
     std::printf("lattice n=%ld, %.0f particles, %ld rounds of %ld steps, %ld thread(s)\n", n,
                 particles[0], rounds, steps, threads);
+  if (threads_b != threads)
+    std::printf("B: %ld thread(s): the same scene on another thread count, whose trajectory must not "
+                "differ\n", threads_b);
   if (nb != n || bonded_b)
     std::printf("B: lattice n=%ld%s, %.0f particles, %ld steps a round\n", nb, bonded_b ? " bonded" : "",
                 particles[1], count[1]);

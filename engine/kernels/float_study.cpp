@@ -100,7 +100,7 @@ const KernelSet& float_study_kernels() {
                              &bond_loop<FloatLanes, true>, &bond_loop<FloatLanes, false>,
                              scalar_kernels().integrate, scalar_kernels().integrate_norot,
                              scalar_kernels().plane_walls, scalar_kernels().plane_walls_norot,
-                             scalar_kernels().gather_pairs, scalar_kernels().gather_bonds};
+                             scalar_kernels().gather};
   return set;
 }
 

@@ -22,78 +22,111 @@ inline bool gather_skips(const GatherArgs& g, std::size_t i) {
   return (g.inert && g.inert[i]) || (g.idle && g.idle[i]);
 }
 
-// Bonds = false: the pair list (records of 8), its sums written to fx..tz[i]; true: the bond
-// list (records of 12), its terms added to them (a particle without bonds is left as it is).
+// Bonds = false: the pair list (records of 8); true: the bond list (records of 12), with the
+// beam's moment, which acts on b and its negative on a.
 template <bool Bonds>
-inline void gather_scalar(const GatherArgs& g, std::size_t begin, std::size_t end) {
+inline void add_incidences_scalar(const GatherArgs& g, std::size_t i, double R, double f[3],
+                                  double t[3]) {
   constexpr std::size_t width = Bonds ? 12 : 8;
-  for (std::size_t i = begin; i < end; ++i) {
-    if (gather_skips(g, i) || (Bonds && g.start[i] == g.start[i + 1])) continue;
-    const double R = g.radius[i];
-    double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
+  for (std::int32_t e = g.start[i]; e < g.start[i + 1]; ++e) {
+    const double* r = g.records + width * std::size_t(g.entry[e] >> 1);
+    const double sgn = (g.entry[e] & 1) ? 1.0 : -1.0;
+    f[0] += sgn * r[0];
+    f[1] += sgn * r[1];
+    f[2] += sgn * r[2];
+    const double lever = R - 0.5 * r[3];
     if constexpr (Bonds) {
-      fx = g.fx[i]; fy = g.fy[i]; fz = g.fz[i];
-      tx = g.tx[i]; ty = g.ty[i]; tz = g.tz[i];
+      t[0] += sgn * r[8] - lever * r[4];
+      t[1] += sgn * r[9] - lever * r[5];
+      t[2] += sgn * r[10] - lever * r[6];
+    } else {
+      t[0] -= lever * r[4];
+      t[1] -= lever * r[5];
+      t[2] -= lever * r[6];
     }
-    for (std::int32_t e = g.start[i]; e < g.start[i + 1]; ++e) {
-      const double* r = g.records + width * std::size_t(g.entry[e] >> 1);
-      const double sgn = (g.entry[e] & 1) ? 1.0 : -1.0;
-      fx += sgn * r[0];
-      fy += sgn * r[1];
-      fz += sgn * r[2];
-      const double lever = R - 0.5 * r[3];
-      if constexpr (Bonds) {  // the beam's moment acts on b, its negative on a
-        tx += sgn * r[8] - lever * r[4];
-        ty += sgn * r[9] - lever * r[5];
-        tz += sgn * r[10] - lever * r[6];
-      } else {
-        tx -= lever * r[4];
-        ty -= lever * r[5];
-        tz -= lever * r[6];
-      }
-    }
-    g.fx[i] = fx; g.fy[i] = fy; g.fz[i] = fz;
-    g.tx[i] = tx; g.ty[i] = ty; g.tz[i] = tz;
+  }
+}
+
+// The scalar reference: each particle's pair sums, then (bonds not null) its bond terms added to
+// them, written once to fx..tz[i].
+inline void gather_scalar(const GatherArgs& pairs, const GatherArgs* bonds, std::size_t begin,
+                          std::size_t end) {
+  const GatherArgs& g = pairs;
+  for (std::size_t i = begin; i < end; ++i) {
+    if (gather_skips(g, i)) continue;
+    const double R = g.radius[i];
+    double f[3] = {0, 0, 0}, t[3] = {0, 0, 0};
+    add_incidences_scalar<false>(pairs, i, R, f, t);
+    if (bonds) add_incidences_scalar<true>(*bonds, i, R, f, t);
+    g.fx[i] = f[0]; g.fy[i] = f[1]; g.fz[i] = f[2];
+    g.tx[i] = t[0]; g.ty[i] = t[1]; g.tz[i] = t[2];
   }
 }
 
 #if defined(__AVX2__)
+// Records of the particle eight ahead (GatherArgs::prefetch).
+inline constexpr std::size_t kGatherAhead = 8;
+
 template <bool Bonds>
-inline void gather_vector(const GatherArgs& g, std::size_t begin, std::size_t end) {
+inline void prefetch_records(const GatherArgs& g, std::size_t i) {
+  constexpr std::size_t width = Bonds ? 12 : 8;
+  for (std::int32_t e = g.start[i]; e < g.start[i + 1]; ++e)
+    _mm_prefetch(reinterpret_cast<const char*>(g.records + width * std::size_t(g.entry[e] >> 1)),
+                 _MM_HINT_T0);
+}
+
+template <bool Bonds>
+inline void add_incidences_vector(const GatherArgs& g, std::size_t i, __m256d R, __m256d& f,
+                                  __m256d& t) {
   constexpr std::size_t width = Bonds ? 12 : 8;
   static const double sign[2] = {-1.0, 1.0};  // by the entry's "is b" bit
   const __m256d half = _mm256_set1_pd(0.5);
-  constexpr std::size_t ahead = 8;  // particles (GatherArgs::prefetch)
+  for (std::int32_t e = g.start[i]; e < g.start[i + 1]; ++e) {
+    const std::int64_t entry = g.entry[e];
+    const double* r = g.records + width * std::size_t(entry >> 1);
+    const __m256d s = _mm256_broadcast_sd(sign + (entry & 1));
+    const __m256d lever = _mm256_sub_pd(R, _mm256_mul_pd(half, _mm256_broadcast_sd(r + 3)));
+    f = _mm256_add_pd(f, _mm256_mul_pd(s, _mm256_load_pd(r)));
+    if constexpr (Bonds)
+      t = _mm256_add_pd(t, _mm256_sub_pd(_mm256_mul_pd(s, _mm256_load_pd(r + 8)),
+                                         _mm256_mul_pd(lever, _mm256_load_pd(r + 4))));
+    else
+      t = _mm256_sub_pd(t, _mm256_mul_pd(lever, _mm256_load_pd(r + 4)));
+  }
+}
+
+// The same sums with one 256-bit vector per quarter record. Pairs and bonds in one pass: the
+// particle's sums stay in two registers from its first pair to its last bond instead of being
+// stored by a pair gather and loaded back by a bond gather (perf/README.md).
+template <bool Bonds>
+inline void gather_vector(const GatherArgs& pairs, const GatherArgs* bonds, std::size_t begin,
+                          std::size_t end) {
+  const GatherArgs& g = pairs;
   for (std::size_t i = begin; i < end; ++i) {
-    if (g.prefetch && i + ahead < end)
-      for (std::int32_t e = g.start[i + ahead]; e < g.start[i + ahead + 1]; ++e)
-        _mm_prefetch(reinterpret_cast<const char*>(g.records + width * std::size_t(g.entry[e] >> 1)),
-                     _MM_HINT_T0);
-    if (gather_skips(g, i) || (Bonds && g.start[i] == g.start[i + 1])) continue;
+    if (i + kGatherAhead < end) {
+      if (pairs.prefetch) prefetch_records<false>(pairs, i + kGatherAhead);
+      if (Bonds && bonds->prefetch) prefetch_records<true>(*bonds, i + kGatherAhead);
+    }
+    if (gather_skips(g, i)) continue;
     const __m256d R = _mm256_set1_pd(g.radius[i]);
     __m256d f = _mm256_setzero_pd(), t = _mm256_setzero_pd();
-    if constexpr (Bonds) {
-      f = _mm256_setr_pd(g.fx[i], g.fy[i], g.fz[i], 0.0);
-      t = _mm256_setr_pd(g.tx[i], g.ty[i], g.tz[i], 0.0);
-    }
-    for (std::int32_t e = g.start[i]; e < g.start[i + 1]; ++e) {
-      const std::int64_t entry = g.entry[e];
-      const double* r = g.records + width * std::size_t(entry >> 1);
-      const __m256d s = _mm256_broadcast_sd(sign + (entry & 1));
-      const __m256d lever = _mm256_sub_pd(R, _mm256_mul_pd(half, _mm256_broadcast_sd(r + 3)));
-      f = _mm256_add_pd(f, _mm256_mul_pd(s, _mm256_load_pd(r)));
-      if constexpr (Bonds)
-        t = _mm256_add_pd(t, _mm256_sub_pd(_mm256_mul_pd(s, _mm256_load_pd(r + 8)),
-                                           _mm256_mul_pd(lever, _mm256_load_pd(r + 4))));
-      else
-        t = _mm256_sub_pd(t, _mm256_mul_pd(lever, _mm256_load_pd(r + 4)));
-    }
+    add_incidences_vector<false>(pairs, i, R, f, t);
+    if constexpr (Bonds) add_incidences_vector<true>(*bonds, i, R, f, t);
     alignas(32) double fo[4], to[4];
     _mm256_store_pd(fo, f);
     _mm256_store_pd(to, t);
     g.fx[i] = fo[0]; g.fy[i] = fo[1]; g.fz[i] = fo[2];
     g.tx[i] = to[0]; g.ty[i] = to[1]; g.tz[i] = to[2];
   }
+}
+
+// The kernel: bonds null where the scene has none.
+inline void gather_vector_kernel(const GatherArgs& pairs, const GatherArgs* bonds,
+                                 std::size_t begin, std::size_t end) {
+  if (bonds)
+    gather_vector<true>(pairs, bonds, begin, end);
+  else
+    gather_vector<false>(pairs, nullptr, begin, end);
 }
 #endif
 

@@ -43,9 +43,9 @@ StageLoop integrate_stage(State& s) {
       applied ? p.az.data() : nullptr, nullptr, nullptr,
       s.dt, s.settings.local_damping, g.x, g.y, g.z};
 
-  // The pair sums and the bond terms of a range of particles (the kernels skip inert and idle
-  // ones, as below).
-  const auto gather_pairs = s.kernels->gather_pairs, gather_bonds = s.kernels->gather_bonds;
+  // The pair sums and the bond terms of a range of particles, in one pass (the kernel skips inert
+  // and idle ones, as below).
+  const auto gather_records = s.kernels->gather;
   kernels::GatherArgs pair_args{inc.start.data(), inc.entry.data(), q.out.data(),
                                 p.radius.data(), p.inert.data(), idle, p.fx.data(),
                                 p.fy.data(), p.fz.data(), p.tx.data(), p.ty.data(),
@@ -87,10 +87,10 @@ StageLoop integrate_stage(State& s) {
     Fz[i] += az[i];
   };
   const bool any_bonds = bq.n > 0;
-  // The whole gather of one particle (the pair kernel's part included).
+  // The whole gather of one particle (the pair kernel's part included). The lambdas keep copies
+  // of the arguments (the stage outlives this function), so the bond list is named through them.
   auto gather = [=](std::size_t i) __attribute__((always_inline)) {
-    gather_pairs(pair_args, i, i + 1);
-    if (any_bonds) gather_bonds(bond_args, i, i + 1);
+    gather_records(pair_args, any_bonds ? &bond_args : nullptr, i, i + 1);
     for (std::int32_t k = wstart[i]; k < wstart[i + 1]; ++k) add_wall(k);
     if (applied) add_applied(i);
   };
@@ -121,8 +121,7 @@ StageLoop integrate_stage(State& s) {
     a.spin = spin;
     // The gather in passes over the block, each particle's terms in the order pairs, bonds,
     // walls, applied (as `gather`): inert and idle particles have none and are skipped.
-    gather_pairs(pair_args, first, end);
-    if (any_bonds) gather_bonds(bond_args, first, end);
+    gather_records(pair_args, any_bonds ? &bond_args : nullptr, first, end);
     for (std::int32_t k = wstart[first]; k < wstart[end]; ++k)
       if (!inert[wparticle[k]] && !idle[wparticle[k]]) add_wall(k);
     if (applied)

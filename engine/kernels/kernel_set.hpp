@@ -10,7 +10,7 @@
 namespace asperity::kernels {
 
 template <class Lanes>
-KernelSet loop_kernels(const char* name, GatherKernel gather_pairs, GatherKernel gather_bonds) {
+KernelSet loop_kernels(const char* name, GatherKernel gather) {
   return {name,
           Lanes::size,
           &pair_loop<Lanes, true>,
@@ -21,8 +21,7 @@ KernelSet loop_kernels(const char* name, GatherKernel gather_pairs, GatherKernel
           &integrate_loop<Lanes, false>,
           &plane_wall_loop<Lanes, true>,
           &plane_wall_loop<Lanes, false>,
-          gather_pairs,
-          gather_bonds};
+          gather};
 }
 
 }  // namespace asperity::kernels

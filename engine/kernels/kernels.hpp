@@ -79,14 +79,14 @@ struct PlaneWallArgs {
 
 using PlaneWallKernel = void (*)(const PlaneWallArgs&, std::size_t begin, std::size_t end);
 
-// Gather kernels (gather_loop.hpp), for each particle i in [begin, end) not marked in `inert` or
-// `idle` (either may be null), in the order of its incidences:
-// - pairs: the sum of the force and torque the pair records give it (store/pairs.hpp: record
-//   fx fy fz U cx cy cz 0; on b: +F, on a: -F; on either: -(R - U/2) n x Fs), written to
-//   fx..tz[i];
-// - bonds: the same from the bond records (store/bonds.hpp), plus the beam moment (+M on b, -M on
-//   a), added to fx..tz[i].
-// The walls and applied forces are added by the caller (kernels/integrate.cpp).
+// The gather kernel (gather_loop.hpp), for each particle i in [begin, end) not marked in `inert`
+// or `idle` (either may be null; the pairs' arguments say), in the order of its incidences:
+// - the sum of the force and torque the pair records give it (store/pairs.hpp: record
+//   fx fy fz U cx cy cz fn; on b: +F, on a: -F; on either: -(R - U/2) n x Fs);
+// - then, where a bond list is given, the same from the bond records (store/bonds.hpp) plus the
+//   beam moment (+M on b, -M on a), added to those sums;
+// written to fx..tz[i] (the pairs' arguments name the columns). The walls and applied forces are
+// added by the caller (kernels/integrate.cpp).
 struct GatherArgs {
   const std::int32_t* start;  // incidence CSR (store/pairs.hpp, Incidence)
   const std::int64_t* entry;  // (pair or bond << 1) | (particle is b)
@@ -101,7 +101,8 @@ struct GatherArgs {
   bool prefetch = false;
 };
 
-using GatherKernel = void (*)(const GatherArgs&, std::size_t begin, std::size_t end);
+using GatherKernel = void (*)(const GatherArgs& pairs, const GatherArgs* bonds, std::size_t begin,
+                              std::size_t end);
 
 // Integrate kernel (integrate_loop.hpp): particles [begin, end), begin a multiple of kMaxLanes and
 // end padded up to one (the padding particles have free = 0). `free` and `spin` are 0/1 masks
@@ -143,8 +144,7 @@ struct KernelSet {
   IntegrateKernel integrate_norot;  // no particle can rotate: w and torques are not read
   PlaneWallKernel plane_walls;       // with rotation
   PlaneWallKernel plane_walls_norot;
-  GatherKernel gather_pairs;
-  GatherKernel gather_bonds;
+  GatherKernel gather;
 };
 
 const KernelSet& scalar_kernels();

@@ -34,7 +34,7 @@ struct ScalarLanes {
 
 const KernelSet& scalar_kernels() {
   static const KernelSet set =
-      loop_kernels<ScalarLanes>("scalar", &gather_scalar<false>, &gather_scalar<true>);
+      loop_kernels<ScalarLanes>("scalar", &gather_scalar);
   return set;
 }
 

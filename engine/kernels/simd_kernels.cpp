@@ -158,9 +158,9 @@ struct SimdLanes {
 };
 
 #if defined(__AVX2__)
-constexpr GatherKernel gather_pairs = &gather_vector<false>, gather_bonds = &gather_vector<true>;
+constexpr GatherKernel gather = &gather_vector_kernel;
 #else  // SSE: two lanes do not beat the scalar loop here
-constexpr GatherKernel gather_pairs = &gather_scalar<false>, gather_bonds = &gather_scalar<true>;
+constexpr GatherKernel gather = &gather_scalar;
 #endif
 
 }  // namespace
@@ -170,7 +170,7 @@ constexpr GatherKernel gather_pairs = &gather_scalar<false>, gather_bonds = &gat
 
 const KernelSet& ASPERITY_CAT(kernels_, ASPERITY_SIMD_ARCH)() {
   static const KernelSet set =
-      loop_kernels<SimdLanes>(ASPERITY_STR(ASPERITY_SIMD_ARCH), gather_pairs, gather_bonds);
+      loop_kernels<SimdLanes>(ASPERITY_STR(ASPERITY_SIMD_ARCH), gather);
   return set;
 }
 
