@@ -343,6 +343,41 @@ TEST(Determinism, SimdIntegrateEqualsTheScalarReferenceBitwise) {
   }
 }
 
+// The integrate stage runs a block in which no particle may turn (spin mask all 0: a bonded
+// specimen) through the kernel without rotation: it must give the bits of the kernel with it,
+// state and sums, on every architecture.
+TEST(Determinism, IntegrateWithoutSpinIsTheFullKernelWhereNothingTurns) {
+  std::vector<const kernels::KernelSet*> sets{&kernels::scalar_kernels()};
+  for (const auto& arch : available_simd_architectures()) sets.push_back(&kernels::select_kernels(arch));
+  for (const kernels::KernelSet* ks : sets) {
+    for (bool with_nan : {false, true}) {
+      RandomParticles full(9, with_nan), norot(9, with_nan);
+      for (auto* p : {&full, &norot}) std::fill(p->spin.begin(), p->spin.end(), 0.0);
+      kernels::IntegrateSums sf, sn;
+      ks->integrate(full.args(), 0, RandomParticles::padded, sf);
+      ks->integrate_norot(norot.args(), 0, RandomParticles::padded, sn);
+      for (auto c : {&RandomParticles::x, &RandomParticles::y, &RandomParticles::z,
+                     &RandomParticles::vx, &RandomParticles::vy, &RandomParticles::vz,
+                     &RandomParticles::wx, &RandomParticles::wy, &RandomParticles::wz})
+        EXPECT_EQ(0, std::memcmp((full.*c).data(), (norot.*c).data(), RandomParticles::padded * sizeof(double)))
+            << ks->name;
+      auto bits = [](double v) {
+        std::uint64_t u;
+        std::memcpy(&u, &v, sizeof u);
+        return u;
+      };
+      for (auto [a, b] : {std::pair{sf.damping, sn.damping}, {sf.gravity, sn.gravity},
+                          {sf.applied, sn.applied}, {sf.kinetic, sn.kinetic},
+                          {sf.max_disp2, sn.max_disp2}, {sf.worst_step, sn.worst_step}})
+        EXPECT_EQ(bits(a), bits(b)) << ks->name << (with_nan ? " with a NaN" : "");
+      EXPECT_EQ(sf.worst, sn.worst) << ks->name;
+      if (!with_nan) {
+        EXPECT_GT(sf.damping, 0.0) << "the block does move and dissipate";
+      }
+    }
+  }
+}
+
 namespace {
 // Random ball-plane contacts in every state: touching or not, fresh (zero stored normal) or
 // carrying a shear force that sticks or slides, spinning, on moving planes of different
