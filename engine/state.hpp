@@ -90,6 +90,10 @@ struct State {
   std::vector<double> bond_block_breaks;
   std::vector<std::uint8_t> user_rotation_locked;  // set by the API; bonds add their own lock
   bool any_rotating = true;  // some particle can rotate: kernels read angular velocities
+  // Every bond's beam moments are +-0 (set by a scan in refresh_bond_topology, cleared by a bond
+  // stage that runs with spin): only spin makes them grow, so the bond stage may take the kernel
+  // that neither carries nor stores them (kernels/bonds.cpp).
+  bool bond_moments_zero = false;
   // Some bond was installed stress-free: the pair and bond kernels read rest overlaps (which are
   // all 0 otherwise, so a world without such bonds never reads the columns). Never reset.
   bool rest_overlaps = false;

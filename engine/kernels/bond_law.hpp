@@ -47,13 +47,18 @@ struct BondState {
 // model.md 5), and every term of w is left out: it would add or rotate by an exact +-0, so the
 // values are those of Spin = true except for the sign of an exact zero (carry_shear). The AVX2
 // loop then issues 105 multiplies and 86 adds per batch instead of 206 and 149 (perf/README.md).
-template <class T, bool Spin = true>
+// Moments = false (only with Spin = false): the beam carries no moment, mbn = mbs = +-0 on entry;
+// without spin no increment reaches them and carrying a zero gives a zero, so they stay +-0 and
+// are neither carried nor read (the caller leaves their columns alone). Their terms of the
+// periphery stresses are exact zeros, added as +0: sigma and tau are the same bits.
+template <class T, bool Spin = true, bool Moments = true>
 inline T bond_forces(const T& nx, const T& ny, const T& nz, const T& U, const T& la, const T& lb,
                      const T& rb, const T& vax, const T& vay, const T& vaz, const T& wax,
                      const T& way, const T& waz, const T& vbx, const T& vby, const T& vbz,
                      const T& wbx, const T& wby, const T& wbz, const T& ox, const T& oy,
                      const T& oz, const T& U0, BondState<T>& s, T& sigma, T& tau,
                      const BondParams<T>& p) {
+  static_assert(Moments || !Spin, "the moments grow wherever the bodies spin");
   // Relative velocity at the contact point [3-17, 3-18] and spin angle, as for a contact.
   T vn, vsx, vsy, vsz, phi;
   contact_kinematics<T, Spin>(nx, ny, nz, la, lb, vax, vay, vaz, wax, way, waz, vbx, vby, vbz, wbx,
@@ -61,7 +66,7 @@ inline T bond_forces(const T& nx, const T& ny, const T& nz, const T& U, const T&
   // Shear force, beam shear force and bending moment are carried with the contact plane.
   carry_shear<T, Spin>(ox, oy, oz, nx, ny, nz, phi, s.fsx, s.fsy, s.fsz);
   carry_shear<T, Spin>(ox, oy, oz, nx, ny, nz, phi, s.fbsx, s.fbsy, s.fbsz);
-  carry_shear<T, Spin>(ox, oy, oz, nx, ny, nz, phi, s.mbsx, s.mbsy, s.mbsz);
+  if constexpr (Moments) carry_shear<T, Spin>(ox, oy, oz, nx, ny, nz, phi, s.mbsx, s.mbsy, s.mbsz);
 
   // Contact bond: springs in tension too, no slip; unloaded at the rest overlap U0 (0 unless the
   // bond was installed stress-free).
@@ -90,10 +95,15 @@ inline T bond_forces(const T& nx, const T& ny, const T& nz, const T& U, const T&
   // Periphery stresses [3-27] with A = pi Rb^2, I = pi Rb^4 / 4, J = pi Rb^4 / 2.
   const T A = kPi * r2;
   const T fbs = sqrt(s.fbsx * s.fbsx + s.fbsy * s.fbsy + s.fbsz * s.fbsz);
-  const T mbs = sqrt(s.mbsx * s.mbsx + s.mbsy * s.mbsy + s.mbsz * s.mbsz);
-  const T mbn = select(s.mbn < T(0.0), -s.mbn, s.mbn);
-  sigma = -s.fbn / A + mbs * 4.0 / (A * rb);
-  tau = fbs / A + mbn * 2.0 / (A * rb);
+  if constexpr (Moments) {
+    const T mbs = sqrt(s.mbsx * s.mbsx + s.mbsy * s.mbsy + s.mbsz * s.mbsz);
+    const T mbn = select(s.mbn < T(0.0), -s.mbn, s.mbn);
+    sigma = -s.fbn / A + mbs * 4.0 / (A * rb);
+    tau = fbs / A + mbn * 2.0 / (A * rb);
+  } else {  // mbs = +0 and |mbn| = +-0 give +0 and +-0, either of which adds as +0 does
+    sigma = -s.fbn / A + T(0.0);
+    tau = fbs / A + T(0.0);
+  }
   return elliptic_criterion(sigma, tau, p.strength);
 }
 

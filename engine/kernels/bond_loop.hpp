@@ -6,7 +6,9 @@
 
 namespace asperity::kernels {
 
-template <class Lanes, bool Rotation>
+// Moments = false (with Rotation = false): the beams carry no moment (bond_law.hpp); their four
+// columns are neither read nor written and the record's moment is +0.
+template <class Lanes, bool Rotation, bool Moments = true>
 double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
   using T = typename Lanes::Real;
   const BondParams<T> p{T(k.kn), T(k.ks), T(k.beam_kn), T(k.beam_ks), T(k.dt), T(k.strength)};
@@ -19,15 +21,18 @@ double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
     const T ox = Lanes::load(k.nx + i), oy = Lanes::load(k.ny + i), oz = Lanes::load(k.nz + i);
     BondState<T> s{Lanes::load(k.fsx + i), Lanes::load(k.fsy + i), Lanes::load(k.fsz + i), T(0.0),
                    Lanes::load(k.fbn + i), Lanes::load(k.fbsx + i), Lanes::load(k.fbsy + i),
-                   Lanes::load(k.fbsz + i), Lanes::load(k.mbn + i), Lanes::load(k.mbsx + i),
-                   Lanes::load(k.mbsy + i), Lanes::load(k.mbsz + i)};
+                   Lanes::load(k.fbsz + i), T(0.0), T(0.0), T(0.0), T(0.0)};
+    if constexpr (Moments) {
+      s.mbn = Lanes::load(k.mbn + i);
+      s.mbsx = Lanes::load(k.mbsx + i); s.mbsy = Lanes::load(k.mbsy + i); s.mbsz = Lanes::load(k.mbsz + i);
+    }
     const T rbeam = Lanes::load(k.beam_radius + i);
     // Padding bonds have Rb = 0; give them a harmless radius so no lane divides by zero.
     const auto real = rbeam > T(0.0);
     const T rsafe = select(real, rbeam, T(1.0));
     const T u0 = k.rest ? Lanes::load(k.rest + i) : T(0.0);
     T sigma, tau;
-    const T crit = bond_forces<T, Rotation>(nx, ny, nz, U, la, lb, rsafe, q.vax, q.vay, q.vaz,
+    const T crit = bond_forces<T, Rotation, Moments>(nx, ny, nz, U, la, lb, rsafe, q.vax, q.vay, q.vaz,
                                             q.wax, q.way, q.waz, q.vbx, q.vby, q.vbz, q.wbx, q.wby,
                                             q.wbz, ox, oy, oz, u0, s, sigma, tau, p);
     T brk(0.0);
@@ -42,8 +47,10 @@ double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
     Lanes::store(k.overlap + i, U);
     Lanes::store(k.fbn + i, s.fbn);
     Lanes::store(k.fbsx + i, s.fbsx); Lanes::store(k.fbsy + i, s.fbsy); Lanes::store(k.fbsz + i, s.fbsz);
-    Lanes::store(k.mbn + i, s.mbn);
-    Lanes::store(k.mbsx + i, s.mbsx); Lanes::store(k.mbsy + i, s.mbsy); Lanes::store(k.mbsz + i, s.mbsz);
+    if constexpr (Moments) {
+      Lanes::store(k.mbn + i, s.mbn);
+      Lanes::store(k.mbsx + i, s.mbsx); Lanes::store(k.mbsy + i, s.mbsy); Lanes::store(k.mbsz + i, s.mbsz);
+    }
     Lanes::store(k.broken + i, brk);
     // For the gather (kernels/integrate.cpp), with the operations it would do per side: the
     // record fx fy fz U cx cy cz 0 mx my mz 0 of each bond (store/bonds.hpp).
@@ -51,7 +58,9 @@ double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
     const T sx = s.fsx + s.fbsx, sy = s.fsy + s.fbsy, sz = s.fsz + s.fbsz;
     const T record[12] = {ftot * nx + sx, ftot * ny + sy, ftot * nz + sz, U,
                           ny * sz - nz * sy, nz * sx - nx * sz, nx * sy - ny * sx, T(0.0),
-                          s.mbn * nx + s.mbsx, s.mbn * ny + s.mbsy, s.mbn * nz + s.mbsz, T(0.0)};
+                          Moments ? s.mbn * nx + s.mbsx : T(0.0),
+                          Moments ? s.mbn * ny + s.mbsy : T(0.0),
+                          Moments ? s.mbn * nz + s.mbsz : T(0.0), T(0.0)};
     Lanes::template store_records<12>(k.out + 12 * i, record);
   }
   return Lanes::sum(count);

@@ -91,6 +91,10 @@ void refresh_bond_topology(State& s) {
   s.bonded_particles.clear();
   for (std::size_t i = 0; i < p.n; ++i)
     if (s.partner_start[i + 1] > s.partner_start[i]) s.bonded_particles.push_back(std::int32_t(i));
+  // Beam moments: new bonds start without one, and a checkpoint or a break may bring back some.
+  s.bond_moments_zero = true;
+  for (std::size_t k = 0; k < q.n && s.bond_moments_zero; ++k)
+    s.bond_moments_zero = q.mbn[k] == 0 && q.mbsx[k] == 0 && q.mbsy[k] == 0 && q.mbsz[k] == 0;
   // Rotation locks [thesis 3.3]: a particle holding an intact bond does not rotate.
   s.user_rotation_locked.resize(p.n, 0);
   s.any_rotating = false;
@@ -125,7 +129,12 @@ StageLoop bond_stage(State& s) {
         break;
       }
   }
-  const auto kernel = spin ? s.kernels->bond : s.kernels->bond_norot;
+  // Without spin no moment grows: while every beam moment is zero (a bonded specimen whose
+  // particles never turned: the joints) the kernel leaves the four moment columns alone, 0.94 of
+  // the joint's one-thread step (perf/README.md). A step with spin may give them values.
+  const auto kernel = spin ? s.kernels->bond
+                           : (s.bond_moments_zero ? s.kernels->bond_no_moment : s.kernels->bond_norot);
+  if (spin) s.bond_moments_zero = false;
   const std::size_t total = s.bonds.padded;
   st.blocks = (total + kPairBlock - 1) / kPairBlock;
   s.bond_block_breaks.assign(st.blocks, 0.0);

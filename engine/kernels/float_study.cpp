@@ -98,6 +98,7 @@ const KernelSet& float_study_kernels() {
   // The integration, the plane walls and the gather are the scalar reference's, in double.
   static const KernelSet set{"float", 1, &pair_loop<FloatLanes, true>, &pair_loop<FloatLanes, false>,
                              &bond_loop<FloatLanes, true>, &bond_loop<FloatLanes, false>,
+                             &bond_loop<FloatLanes, false, false>,
                              scalar_kernels().integrate, scalar_kernels().integrate_norot,
                              scalar_kernels().plane_walls, scalar_kernels().plane_walls_norot,
                              scalar_kernels().gather};

@@ -140,6 +140,7 @@ struct KernelSet {
   PairKernel pair_norot;   // every particle's rotation locked: w is not read
   BondKernel bond;
   BondKernel bond_norot;
+  BondKernel bond_no_moment;  // no spin and no beam moment (bond_loop.hpp): the moments untouched
   IntegrateKernel integrate;        // with rotation
   IntegrateKernel integrate_norot;  // no particle can rotate: w and torques are not read
   PlaneWallKernel plane_walls;       // with rotation

@@ -103,6 +103,34 @@ TEST(Bonds, BendingStressIsFourMOverPiRCubed) {
   EXPECT_NEAR(norm(got - expected), 0.0, 1e-9 * norm(expected));
 }
 
+// While no bonded particle turns and every beam moment is zero, the bond stage takes the kernel
+// that leaves the moments alone (kernels/bonds.cpp). Once a turn has bent the beam, a step without
+// spin must still carry the moment and pass it to the particles.
+TEST(Bonds, BeamMomentStillActsAfterTheTurningStops) {
+  BondMaterial bm;
+  bm.breakable = false;
+  const double omega = 1e-3;
+  Pair p = bonded_pair(bm, moving({0, 0, 0}, {omega, 0, 0}), false);
+  p.w.cycle(1000);
+  p.w.set_group_motion(p.gb, moving({0, 0, 0}));  // held: no turn from here on
+  p.w.cycle(1);  // whose forces still saw the last turn
+  const double M = norm(p.w.bonds()[0].bending_moment);
+  ASSERT_GT(M, 0.0);
+  p.w.cycle(20);
+  for (std::int64_t id : {p.a, p.b}) {
+    const Vec3 w = p.w.angular_velocity(id);
+    ASSERT_TRUE(w.x == 0 && w.y == 0 && w.z == 0 && !std::signbit(w.x) && !std::signbit(w.y) &&
+                !std::signbit(w.z))
+        << "both at +0: the steps ran the kernel without spin";
+  }
+  const BondInfo b = p.w.bonds()[0];
+  EXPECT_NEAR(norm(b.bending_moment), M, 1e-12 * M) << "the beam stays bent";
+  const Vec3 expected = -(b.normal * b.twisting_moment + b.bending_moment) -
+                        (kR + 0.5 * b.gap) * cross(b.normal, b.shear_force);
+  EXPECT_GT(norm(b.bending_moment), 0.5 * norm(expected));
+  EXPECT_NEAR(norm(p.w.torque(p.a) - expected), 0.0, 1e-9 * norm(expected)) << "and still acts";
+}
+
 TEST(Bonds, TwistingStressIsTwoTOverPiRCubed) {
   BondMaterial bm;
   bm.breakable = false;
@@ -376,8 +404,9 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
     for (int c = 12; c < 16; ++c) hist[c][k] = 1e-10 * u(rng);
     hist[27][k] = (k % 3 == 0) ? 0.01 * r[ia] * u(rng) : 0.0;  // rest overlaps, stress-free bonds
   }
+  // kernel: 0 the full law, 1 without spin, 2 without spin and beam moments.
   auto run = [&](const kernels::KernelSet& ks, std::vector<AVec<double>> h, bool rest,
-                 bool rotation = true) {
+                 int kernel = 0) {
     kernels::BondKernelArgs args{x.data(), y.data(), z.data(), vx.data(), vy.data(), vz.data(),
                                  wx.data(), wy.data(), wz.data(), r.data(), a.data(), b.data(),
                                  rb.data(), h[0].data(), h[1].data(), h[2].data(), h[3].data(),
@@ -389,7 +418,7 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
     // The gather's records (store/bonds.hpp): every slot written, the two pads with 0.
     AVec<double> records(12 * bonds, -7.0);
     args.out = records.data();
-    const double broken = (rotation ? ks.bond : ks.bond_norot)(args, 0, bonds);
+    const double broken = (kernel == 0 ? ks.bond : kernel == 1 ? ks.bond_norot : ks.bond_no_moment)(args, 0, bonds);
     // Record column j as a column of its own (18 + j for the force, overlap and n x Fs, then
     // the moment), so the comparisons below see them.
     for (std::size_t k = 0; k < bonds; ++k) {
@@ -435,11 +464,42 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
   for (auto* c : {&wx, &wy, &wz}) std::fill(c->begin(), c->end(), 0.0);
   for (const auto& arch : available_simd_architectures()) {
     const auto& ks = kernels::select_kernels(arch);
-    const auto full = run(ks, hist, true, true), shortcut = run(ks, hist, true, false);
+    const auto full = run(ks, hist, true, 0), shortcut = run(ks, hist, true, 1);
     EXPECT_EQ(full.first, shortcut.first) << arch;
     for (int c = 0; c < 28; ++c)
       EXPECT_EQ(0, std::memcmp(full.second[c].data(), shortcut.second[c].data(), bonds * sizeof(double)))
           << arch << " column " << c;
+  }
+  // And with every beam moment +-0 as well (a specimen whose bonded particles never turned), the
+  // kernel that neither carries nor stores the moments: the same bits in every other column and
+  // in the criterion (the breaks), the moment columns left as they were, the record's moment +0
+  // where the kernel without spin gives +-0. Its SIMD forms equal its scalar reference.
+  for (int c = 12; c < 16; ++c)
+    for (std::size_t k = 0; k < bonds; ++k) hist[c][k] = (k + std::size_t(c)) % 3 == 0 ? -0.0 : 0.0;
+  const auto no_moment_ref = run(kernels::scalar_kernels(), hist, true, 2);
+  for (const auto& arch : available_simd_architectures()) {
+    const auto& ks = kernels::select_kernels(arch);
+    const auto carried = run(ks, hist, true, 1), unmoved = run(ks, hist, true, 2);
+    EXPECT_EQ(carried.first, unmoved.first) << arch;
+    EXPECT_GT(unmoved.first, 0.0) << "the criterion still breaks bonds";
+    for (int c = 0; c < 28; ++c) {
+      const auto& got = unmoved.second[c];
+      EXPECT_EQ(0, std::memcmp(got.data(), no_moment_ref.second[c].data(), bonds * sizeof(double)))
+          << arch << " column " << c << " against the scalar reference";
+      if (c >= 12 && c <= 15) {
+        EXPECT_EQ(0, std::memcmp(got.data(), hist[c].data(), bonds * sizeof(double)))
+            << arch << " moment column " << c << " is not written";
+      } else if (c == 16 || c == 25 || c == 26) {  // the record's moment
+        for (std::size_t k = 0; k < bonds; ++k) {
+          ASSERT_EQ(carried.second[c][k], 0.0) << arch << " column " << c << " bond " << k;
+          ASSERT_EQ(got[k], 0.0) << arch << " column " << c << " bond " << k;
+          ASSERT_FALSE(std::signbit(got[k])) << arch << " column " << c << " bond " << k;
+        }
+      } else {
+        EXPECT_EQ(0, std::memcmp(got.data(), carried.second[c].data(), bonds * sizeof(double)))
+            << arch << " column " << c;
+      }
+    }
   }
 }
 INSTANTIATE_TEST_SUITE_P(Bonds, SimdBondKernel, ::testing::Values(false, true),
