@@ -23,8 +23,9 @@ inline bool gather_skips(const GatherArgs& g, std::size_t i) {
 }
 
 // Bonds = false: the pair list (records of 8); true: the bond list (records of 12), with the
-// beam's moment, which acts on b and its negative on a.
-template <bool Bonds>
+// beam's moment, which acts on b and its negative on a, unless Moment = false: every moment is
+// zero (GatherArgs::moments), and t - lever C is what t + (s 0 - lever C) gives.
+template <bool Bonds, bool Moment = Bonds>
 inline void add_incidences_scalar(const GatherArgs& g, std::size_t i, double R, double f[3],
                                   double t[3]) {
   constexpr std::size_t width = Bonds ? 12 : 8;
@@ -35,7 +36,7 @@ inline void add_incidences_scalar(const GatherArgs& g, std::size_t i, double R, 
     f[1] += sgn * r[1];
     f[2] += sgn * r[2];
     const double lever = R - 0.5 * r[3];
-    if constexpr (Bonds) {
+    if constexpr (Moment) {
       t[0] += sgn * r[8] - lever * r[4];
       t[1] += sgn * r[9] - lever * r[5];
       t[2] += sgn * r[10] - lever * r[6];
@@ -57,7 +58,10 @@ inline void gather_scalar(const GatherArgs& pairs, const GatherArgs* bonds, std:
     const double R = g.radius[i];
     double f[3] = {0, 0, 0}, t[3] = {0, 0, 0};
     add_incidences_scalar<false>(pairs, i, R, f, t);
-    if (bonds) add_incidences_scalar<true>(*bonds, i, R, f, t);
+    if (bonds && bonds->moments)
+      add_incidences_scalar<true>(*bonds, i, R, f, t);
+    else if (bonds)
+      add_incidences_scalar<true, false>(*bonds, i, R, f, t);
     g.fx[i] = f[0]; g.fy[i] = f[1]; g.fz[i] = f[2];
     g.tx[i] = t[0]; g.ty[i] = t[1]; g.tz[i] = t[2];
   }
@@ -75,7 +79,7 @@ inline void prefetch_records(const GatherArgs& g, std::size_t i) {
                  _MM_HINT_T0);
 }
 
-template <bool Bonds>
+template <bool Bonds, bool Moment = Bonds>
 inline void add_incidences_vector(const GatherArgs& g, std::size_t i, __m256d R, __m256d& f,
                                   __m256d& t) {
   constexpr std::size_t width = Bonds ? 12 : 8;
@@ -87,7 +91,7 @@ inline void add_incidences_vector(const GatherArgs& g, std::size_t i, __m256d R,
     const __m256d s = _mm256_broadcast_sd(sign + (entry & 1));
     const __m256d lever = _mm256_sub_pd(R, _mm256_mul_pd(half, _mm256_broadcast_sd(r + 3)));
     f = _mm256_add_pd(f, _mm256_mul_pd(s, _mm256_load_pd(r)));
-    if constexpr (Bonds)
+    if constexpr (Moment)
       t = _mm256_add_pd(t, _mm256_sub_pd(_mm256_mul_pd(s, _mm256_load_pd(r + 8)),
                                          _mm256_mul_pd(lever, _mm256_load_pd(r + 4))));
     else
@@ -98,7 +102,7 @@ inline void add_incidences_vector(const GatherArgs& g, std::size_t i, __m256d R,
 // The same sums with one 256-bit vector per quarter record. Pairs and bonds in one pass: the
 // particle's sums stay in two registers from its first pair to its last bond instead of being
 // stored by a pair gather and loaded back by a bond gather (perf/README.md).
-template <bool Bonds>
+template <bool Bonds, bool Moment = Bonds>
 inline void gather_vector(const GatherArgs& pairs, const GatherArgs* bonds, std::size_t begin,
                           std::size_t end) {
   const GatherArgs& g = pairs;
@@ -111,7 +115,7 @@ inline void gather_vector(const GatherArgs& pairs, const GatherArgs* bonds, std:
     const __m256d R = _mm256_set1_pd(g.radius[i]);
     __m256d f = _mm256_setzero_pd(), t = _mm256_setzero_pd();
     add_incidences_vector<false>(pairs, i, R, f, t);
-    if constexpr (Bonds) add_incidences_vector<true>(*bonds, i, R, f, t);
+    if constexpr (Bonds) add_incidences_vector<true, Moment>(*bonds, i, R, f, t);
     alignas(32) double fo[4], to[4];
     _mm256_store_pd(fo, f);
     _mm256_store_pd(to, t);
@@ -123,7 +127,9 @@ inline void gather_vector(const GatherArgs& pairs, const GatherArgs* bonds, std:
 // The kernel: bonds null where the scene has none.
 inline void gather_vector_kernel(const GatherArgs& pairs, const GatherArgs* bonds,
                                  std::size_t begin, std::size_t end) {
-  if (bonds)
+  if (bonds && !bonds->moments)
+    gather_vector<true, false>(pairs, bonds, begin, end);
+  else if (bonds)
     gather_vector<true>(pairs, bonds, begin, end);
   else
     gather_vector<false>(pairs, nullptr, begin, end);

@@ -99,6 +99,9 @@ struct GatherArgs {
   // past the caches, whose lines the incidences reach out of order (kernels/integrate.cpp,
   // records_past_caches in state.hpp; perf/README.md).
   bool prefetch = false;
+  // Bond lists: false while every beam moment is zero (State::bond_moments_zero), whose terms the
+  // gather then leaves out.
+  bool moments = true;
 };
 
 using GatherKernel = void (*)(const GatherArgs& pairs, const GatherArgs* bonds, std::size_t begin,
