@@ -10,10 +10,13 @@
 #include <numeric>
 #include <random>
 #include <tuple>
+#include <type_traits>
 #include <string>
 
 #include "core/aligned.hpp"
+#include "kernels/contact_law.hpp"
 #include "kernels/kernels.hpp"
+#include "kernels/pair_loop.hpp"
 #include "scenes.hpp"
 #include "state.hpp"
 
@@ -180,6 +183,70 @@ TEST(Determinism, SimdKernelsEqualTheScalarReferenceBitwise) {
       EXPECT_LT(touching, 3 * pairs / 4);
     }
   }
+}
+
+// The pair kernels skip the law for a stage of pairs in which none touches (pair_loop.hpp): on
+// pairs of which whole stages miss (as in a bonded specimen, whose touching pairs became bonds)
+// and the others touch or miss at random, every kernel must give, pair by pair, the bits of the
+// law itself (contact_law.hpp applied to the one pair, the record formed as the kernel forms it).
+TEST(Determinism, PairKernelSkipsStagesOfNearMissesWithTheLawsBits) {
+  const std::size_t pairs = 4096;
+  std::vector<const kernels::KernelSet*> sets{&kernels::scalar_kernels()};
+  for (const auto& arch : available_simd_architectures()) sets.push_back(&kernels::select_kernels(arch));
+  for (bool rotation : {true, false})
+    for (bool rest : {false, true}) {
+      RandomPairs base(pairs, 23);
+      base.with_rest = rest;
+      std::size_t misses = 0;
+      for (std::size_t k = 0; k < pairs; ++k) {
+        const auto ia = std::size_t(base.a[k]), ib = std::size_t(base.b[k]);
+        if ((k / kernels::kPairStage) % 2 == 0) {  // b moved out to 1.02 .. 1.1 (Ra + Rb)
+          const double dx = base.x[ib] - base.x[ia], dy = base.y[ib] - base.y[ia], dz = base.z[ib] - base.z[ia];
+          const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
+          const double f = (base.r[ia] + base.r[ib]) * (1.06 + 0.04 * std::sin(double(k))) / d;
+          base.x[ib] = base.x[ia] + f * dx; base.y[ib] = base.y[ia] + f * dy; base.z[ib] = base.z[ia] + f * dz;
+        }
+      }
+      // The law, pair by pair.
+      RandomPairs law = base;
+      const kernels::LawParams<double> lp{0.1, 0.01, 0.5, 1e-3};
+      double slip_law = 0;
+      for (std::size_t k = 0; k < pairs; ++k) {
+        const auto ia = std::size_t(law.a[k]), ib = std::size_t(law.b[k]);
+        double nx, ny, nz, U, la, lb, fn;
+        kernels::ball_ball_geometry(law.x[ia], law.y[ia], law.z[ia], law.x[ib], law.y[ib], law.z[ib],
+                                    law.r[ia], law.r[ib], nx, ny, nz, U, la, lb);
+        misses += U <= 0;
+        const double u0 = rest ? law.rest[k] : 0.0;
+        double fx = law.fsx[k], fy = law.fsy[k], fz = law.fsz[k];
+        auto law_of = [&](auto spin) {  // the law with or without its spin terms (w unread)
+          return kernels::contact_forces<double, decltype(spin)::value>(
+              nx, ny, nz, U, la, lb, law.vx[ia], law.vy[ia], law.vz[ia], law.wx[ia], law.wy[ia],
+              law.wz[ia], law.vx[ib], law.vy[ib], law.vz[ib], law.wx[ib], law.wy[ib], law.wz[ib],
+              law.nx[k], law.ny[k], law.nz[k], u0, fx, fy, fz, fn, lp);
+        };
+        slip_law += rotation ? law_of(std::true_type{}) : law_of(std::false_type{});
+        if (rest) law.rest[k] = U > 0 ? u0 : 0.0;
+        law.nx[k] = nx; law.ny[k] = ny; law.nz[k] = nz;
+        law.fsx[k] = fx; law.fsy[k] = fy; law.fsz[k] = fz;
+        const double rec[8] = {fn * nx + fx, fn * ny + fy, fn * nz + fz, U,
+                               ny * fz - nz * fy, nz * fx - nx * fz, nx * fy - ny * fx, fn};
+        std::copy(rec, rec + 8, law.out.begin() + std::ptrdiff_t(8 * k));
+      }
+      ASSERT_GT(misses, pairs / 2) << "most pairs miss";
+      ASSERT_LT(misses, pairs - pairs / 8) << "some touch";
+      for (const kernels::KernelSet* ks : sets) {
+        RandomPairs got = base;
+        const double slip = (rotation ? ks->pair : ks->pair_norot)(got.args(), 0, pairs);
+        const std::string what = std::string(ks->name) + (rotation ? " spin" : " no spin") + (rest ? " rest" : "");
+        EXPECT_NEAR(slip, slip_law, 1e-12 * slip_law) << what;
+        EXPECT_GT(slip_law, 0.0);
+        EXPECT_EQ(0, std::memcmp(got.out.data(), law.out.data(), 8 * pairs * sizeof(double))) << what;
+        for (auto c : {&RandomPairs::nx, &RandomPairs::ny, &RandomPairs::nz, &RandomPairs::fsx,
+                       &RandomPairs::fsy, &RandomPairs::fsz, &RandomPairs::rest})
+          EXPECT_EQ(0, std::memcmp((got.*c).data(), (law.*c).data(), pairs * sizeof(double))) << what;
+      }
+    }
 }
 
 // Where no particle spins (every w is +0), the stages take the kernels that leave the spin terms
