@@ -94,6 +94,9 @@ struct State {
   // stage that runs with spin): only spin makes them grow, so the bond stage may take the kernel
   // that neither carries nor stores them (kernels/bonds.cpp).
   bool bond_moments_zero = false;
+  // The layout of the bond records the last bond stage wrote (store/bonds.hpp): with the moment
+  // (12 doubles a bond) or, by the kernel without moments, without (8). The gather reads them so.
+  bool bond_records_with_moments = true;
   // Some bond was installed stress-free: the pair and bond kernels read rest overlaps (which are
   // all 0 otherwise, so a world without such bonds never reads the columns). Never reset.
   bool rest_overlaps = false;

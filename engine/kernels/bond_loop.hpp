@@ -7,7 +7,8 @@
 namespace asperity::kernels {
 
 // Moments = false (with Rotation = false): the beams carry no moment (bond_law.hpp); their four
-// columns are neither read nor written and the record's moment is +0.
+// columns are neither read nor written, and the record is the first eight values only (its
+// moment would be +-0), eight doubles a bond.
 template <class Lanes, bool Rotation, bool Moments = true>
 double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
   using T = typename Lanes::Real;
@@ -56,12 +57,16 @@ double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
     // record fx fy fz U cx cy cz 0 mx my mz 0 of each bond (store/bonds.hpp).
     const T ftot = fn + s.fbn;
     const T sx = s.fsx + s.fbsx, sy = s.fsy + s.fbsy, sz = s.fsz + s.fbsz;
-    const T record[12] = {ftot * nx + sx, ftot * ny + sy, ftot * nz + sz, U,
-                          ny * sz - nz * sy, nz * sx - nx * sz, nx * sy - ny * sx, T(0.0),
-                          Moments ? s.mbn * nx + s.mbsx : T(0.0),
-                          Moments ? s.mbn * ny + s.mbsy : T(0.0),
-                          Moments ? s.mbn * nz + s.mbsz : T(0.0), T(0.0)};
-    Lanes::template store_records<12>(k.out + 12 * i, record);
+    if constexpr (Moments) {
+      const T record[12] = {ftot * nx + sx, ftot * ny + sy, ftot * nz + sz, U,
+                            ny * sz - nz * sy, nz * sx - nx * sz, nx * sy - ny * sx, T(0.0),
+                            s.mbn * nx + s.mbsx, s.mbn * ny + s.mbsy, s.mbn * nz + s.mbsz, T(0.0)};
+      Lanes::template store_records<12>(k.out + 12 * i, record);
+    } else {
+      const T record[8] = {ftot * nx + sx, ftot * ny + sy, ftot * nz + sz, U,
+                           ny * sz - nz * sy, nz * sx - nx * sz, nx * sy - ny * sx, T(0.0)};
+      Lanes::template store_records<8>(k.out + 8 * i, record);
+    }
   }
   return Lanes::sum(count);
 }

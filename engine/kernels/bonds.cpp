@@ -135,6 +135,7 @@ StageLoop bond_stage(State& s) {
   const auto kernel = spin ? s.kernels->bond
                            : (s.bond_moments_zero ? s.kernels->bond_no_moment : s.kernels->bond_norot);
   if (spin) s.bond_moments_zero = false;
+  s.bond_records_with_moments = kernel != s.kernels->bond_no_moment;
   const std::size_t total = s.bonds.padded;
   st.blocks = (total + kPairBlock - 1) / kPairBlock;
   s.bond_block_breaks.assign(st.blocks, 0.0);

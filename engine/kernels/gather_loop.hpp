@@ -28,7 +28,7 @@ inline bool gather_skips(const GatherArgs& g, std::size_t i) {
 template <bool Bonds, bool Moment = Bonds>
 inline void add_incidences_scalar(const GatherArgs& g, std::size_t i, double R, double f[3],
                                   double t[3]) {
-  constexpr std::size_t width = Bonds ? 12 : 8;
+  constexpr std::size_t width = Moment ? 12 : 8;
   for (std::int32_t e = g.start[i]; e < g.start[i + 1]; ++e) {
     const double* r = g.records + width * std::size_t(g.entry[e] >> 1);
     const double sgn = (g.entry[e] & 1) ? 1.0 : -1.0;
@@ -71,9 +71,9 @@ inline void gather_scalar(const GatherArgs& pairs, const GatherArgs* bonds, std:
 // Records of the particle eight ahead (GatherArgs::prefetch).
 inline constexpr std::size_t kGatherAhead = 8;
 
-template <bool Bonds>
+template <bool Moment>
 inline void prefetch_records(const GatherArgs& g, std::size_t i) {
-  constexpr std::size_t width = Bonds ? 12 : 8;
+  constexpr std::size_t width = Moment ? 12 : 8;
   for (std::int32_t e = g.start[i]; e < g.start[i + 1]; ++e)
     _mm_prefetch(reinterpret_cast<const char*>(g.records + width * std::size_t(g.entry[e] >> 1)),
                  _MM_HINT_T0);
@@ -82,7 +82,7 @@ inline void prefetch_records(const GatherArgs& g, std::size_t i) {
 template <bool Bonds, bool Moment = Bonds>
 inline void add_incidences_vector(const GatherArgs& g, std::size_t i, __m256d R, __m256d& f,
                                   __m256d& t) {
-  constexpr std::size_t width = Bonds ? 12 : 8;
+  constexpr std::size_t width = Moment ? 12 : 8;
   static const double sign[2] = {-1.0, 1.0};  // by the entry's "is b" bit
   const __m256d half = _mm256_set1_pd(0.5);
   for (std::int32_t e = g.start[i]; e < g.start[i + 1]; ++e) {
@@ -109,7 +109,7 @@ inline void gather_vector(const GatherArgs& pairs, const GatherArgs* bonds, std:
   for (std::size_t i = begin; i < end; ++i) {
     if (i + kGatherAhead < end) {
       if (pairs.prefetch) prefetch_records<false>(pairs, i + kGatherAhead);
-      if (Bonds && bonds->prefetch) prefetch_records<true>(*bonds, i + kGatherAhead);
+      if (Bonds && bonds->prefetch) prefetch_records<Moment>(*bonds, i + kGatherAhead);
     }
     if (gather_skips(g, i)) continue;
     const __m256d R = _mm256_set1_pd(g.radius[i]);

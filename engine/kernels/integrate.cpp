@@ -56,7 +56,7 @@ StageLoop integrate_stage(State& s) {
   bond_args.start = binc.start.data();
   bond_args.entry = binc.entry.data();
   bond_args.records = bq.out.data();
-  bond_args.moments = !s.bond_moments_zero;
+  bond_args.moments = s.bond_records_with_moments;
   // Records past the caches are prefetched a few particles ahead: lattice n = 40 (12 MB) 0.93 of
   // the step time on one thread, 0.85 on two; in cache (the joint's bonds, 0.9 MB) it costs ~3 %.
   pair_args.prefetch = records_past_caches(q.out);

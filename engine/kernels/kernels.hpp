@@ -46,7 +46,8 @@ struct BondKernelArgs {
   double* mbn; double* mbsx; double* mbsy; double* mbsz;
   double* broken;
   // Output for the gather (store/bonds.hpp): per bond the record fx fy fz U cx cy cz 0 mx my mz 0,
-  // twelve doubles from out + 12 k (32-byte aligned).
+  // twelve doubles from out + 12 k (32-byte aligned); the kernel without moments writes the first
+  // eight only, from out + 8 k.
   double* out;
   double kn, ks, beam_kn, beam_ks, dt, strength;
   std::size_t columns = 0;  // as PairKernelArgs::columns
@@ -99,8 +100,9 @@ struct GatherArgs {
   // past the caches, whose lines the incidences reach out of order (kernels/integrate.cpp,
   // records_past_caches in state.hpp; perf/README.md).
   bool prefetch = false;
-  // Bond lists: false while every beam moment is zero (State::bond_moments_zero), whose terms the
-  // gather then leaves out.
+  // Bond lists: false where the bond kernel without moments wrote the records (every beam moment
+  // zero: State::bond_moments_zero): 8 doubles a bond without the moment, whose terms the gather
+  // then leaves out; true: 12 with it.
   bool moments = true;
 };
 
@@ -143,7 +145,8 @@ struct KernelSet {
   PairKernel pair_norot;   // every particle's rotation locked: w is not read
   BondKernel bond;
   BondKernel bond_norot;
-  BondKernel bond_no_moment;  // no spin and no beam moment (bond_loop.hpp): the moments untouched
+  BondKernel bond_no_moment;  // no spin and no beam moment (bond_loop.hpp): the moments untouched,
+                              // records of 8 doubles (no moment)
   IntegrateKernel integrate;        // with rotation
   IntegrateKernel integrate_norot;  // no particle can rotate: w and torques are not read
   PlaneWallKernel plane_walls;       // with rotation

@@ -35,7 +35,9 @@ struct BondStore {
   // For the gather, computed by the SIMD kernel (outputs of the step only, like PairStore's): the
   // record of bond k is out[kBondRecord k + j], j = 0..11: fx fy fz U cx cy cz 0 mx my mz 0, the
   // force on b (fn + fbn) n + fs + fbs, the overlap, n x (fs + fbs) (torque per lever arm,
-  // negated) and the beam moment on b mbn n + mbs (on a: its negative).
+  // negated) and the beam moment on b mbn n + mbs (on a: its negative). While every moment is zero
+  // the kernel without moments writes records of 8 (the first eight values, from out + 8 k: one
+  // 64-byte line a bond instead of 1.5; State::bond_records_with_moments says which).
   AVec<double> out;
   BondMaterial material;
   bool any = false;                       // a material was set by a first installation
