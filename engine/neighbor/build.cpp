@@ -41,6 +41,10 @@ struct CellGrid {
   std::vector<std::int32_t> cell_of;   // per particle
   std::vector<std::int32_t> start;     // per cell + 1
   std::vector<std::int32_t> members;   // particle indices, by cell, ascending within a cell
+  // Per cell: the rigid group all its particles belong to; -1 where one is free or the cell is
+  // empty, -2 where it holds members of two groups. A member's search skips the cells of its own
+  // group, which hold no pair for it: in a rigid joint that is most of the cells it looks at.
+  std::vector<std::int32_t> group_of_cell;
 
   int clampi(double v, int n) const {
     int i = static_cast<int>(std::floor(v / cell));
@@ -103,6 +107,14 @@ CellGrid make_grid(const ParticleStore& p, double skin) {
   std::vector<std::int32_t> fill(g.start.begin(), g.start.end() - 1);
   for (std::size_t i = 0; i < n; ++i)
     if (g.cell_of[i] >= 0) g.members[fill[g.cell_of[i]]++] = std::int32_t(i);
+  g.group_of_cell.assign(cells, -1);
+  for (std::size_t c = 0; c < cells; ++c) {
+    if (g.start[c] == g.start[c + 1]) continue;
+    std::int32_t common = p.group[std::size_t(g.members[std::size_t(g.start[c])])];
+    for (std::int32_t t = g.start[c] + 1; t < g.start[c + 1] && common >= 0; ++t)
+      if (p.group[std::size_t(g.members[std::size_t(t)])] != common) common = -2;
+    g.group_of_cell[c] = common;
+  }
   return g;
 }
 
@@ -276,6 +288,7 @@ void neighbours_of(const State& s, const CellGrid& g, std::size_t i, Out&& out) 
     for (int j = std::max(cj - 1, 0); j <= std::min(cj + 1, g.ny - 1); ++j)
       for (int m = std::max(ci - 1, 0); m <= std::min(ci + 1, g.nx - 1); ++m) {
         const std::size_t cell = (std::size_t(k) * g.ny + j) * g.nx + m;
+        if (gi >= 0 && g.group_of_cell[cell] == gi) continue;
         for (std::int32_t t = g.start[cell]; t < g.start[cell + 1]; ++t) {
           const std::int32_t o = g.members[t];
           if (std::size_t(o) <= i) continue;

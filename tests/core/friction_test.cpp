@@ -99,8 +99,10 @@ TEST(Friction, ASpinningSphereShearsItsContactInTheFirstStep) {
   // (kernels/pairs.cpp); a spin set through the API must still drive the law's relative velocity
   // at once: A turns about x at w, B rests on it along z, so at the contact point
   // V = -la (wA x n) = (0, la w, 0) and the first step's shear force on B is -ks V dt [3-19].
-  // An inert spinning particle far away (never in a pair) must not matter either way.
-  for (bool bystander : {false, true}) {
+  // An inert spinning particle far away (never in a pair) must not matter either way, nor a crowd
+  // of resting particles out of reach (then the stage asks the pairs' particles, not all).
+  for (int variant = 0; variant < 3; ++variant) {
+    const bool bystander = variant == 1, crowd = variant == 2;
     WorldSettings ws;
     ws.contact = {1e3, 2e2, 0.5};
     ws.reorder_interval = 0;
@@ -115,6 +117,8 @@ TEST(Friction, ASpinningSphereShearsItsContactInTheFirstStep) {
       w.add_group(ids);  // inert particles belong to a rigid body
       w.set_inert(ids);
     }
+    if (crowd)
+      for (int k = 0; k < 20; ++k) w.add_particle({0.01 * (k + 1), 0.02, 0}, R);
     w.set_angular_velocity(a, {omega, 0, 0});
     const double dt = w.critical_dt() / 10;
     w.set_dt(dt);
@@ -123,7 +127,7 @@ TEST(Friction, ASpinningSphereShearsItsContactInTheFirstStep) {
     ASSERT_EQ(c.size(), 1u);
     const double la = R - 0.5 * U;
     EXPECT_NEAR(c[0].shear_force.y, -ws.contact.ks * (la * omega) * dt, 1e-12 * ws.contact.ks * la * omega * dt)
-        << (bystander ? "with" : "without") << " an inert spinning particle";
+        << (bystander ? "with an inert spinning particle" : crowd ? "in a crowd" : "alone");
     EXPECT_EQ(c[0].shear_force.x, 0.0);
   }
 }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "asperity/world.hpp"
 
@@ -24,6 +25,48 @@ TEST(Groups, MemberContactsAreNeverComputed) {
   w.cycle(10);
   EXPECT_EQ(w.stats().pairs, 0u);
   EXPECT_EQ(w.contact_count(), 0u);
+}
+
+// The neighbour search skips the cells that hold only members of the searching particle's own
+// group (neighbor/build.cpp). Two bodies of random spheres that interpenetrate in a band, a few
+// free spheres among them: the list must hold exactly the pairs within reach (Ra + Rb + skin)
+// that join two different bodies or a free sphere, as a search of every pair finds them.
+TEST(Groups, NeighbourListHoldsEveryPairBetweenBodiesAndNoneWithinOne) {
+  WorldSettings ws;
+  ws.skin = 2e-4;
+  World w(ws);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<std::int64_t> lower, upper, all;
+  std::vector<Vec3> at;
+  std::vector<double> radius;
+  std::vector<int> body;
+  for (int k = 0; k < 900; ++k) {
+    const Vec3 c{0.006 * u(rng), 0.006 * u(rng), 0.006 * u(rng)};
+    const double R = 2e-4 * (1 + 0.5 * u(rng));
+    const auto id = w.add_particle(c, R);
+    // Lower body below z = 2.5 mm, upper above 3.5 mm (either in the band), free: one in 30.
+    const int b = k % 30 == 0 ? -1 : (c.z < 0.0025 ? 0 : c.z > 0.0035 ? 1 : int(k % 2));
+    if (b == 0) lower.push_back(id);
+    if (b == 1) upper.push_back(id);
+    at.push_back(c);
+    radius.push_back(R);
+    body.push_back(b);
+  }
+  const GroupMotion fixed{{Dof::fixed, Dof::fixed, Dof::fixed}};
+  w.add_group(lower, fixed);
+  w.add_group(upper, fixed);
+  w.cycle(1);  // the list is built on the positions above, before the step moves anything
+  std::size_t expected = 0;
+  for (std::size_t i = 0; i < at.size(); ++i)
+    for (std::size_t j = i + 1; j < at.size(); ++j) {
+      if (body[i] >= 0 && body[i] == body[j]) continue;
+      const Vec3 d = at[j] - at[i];
+      const double reach = radius[i] + radius[j] + ws.skin;
+      expected += dot(d, d) < reach * reach;
+    }
+  ASSERT_GT(expected, 200u);
+  EXPECT_EQ(w.stats().pairs, expected);
 }
 
 TEST(Groups, PrescribedVelocityIsFollowedExactly) {
