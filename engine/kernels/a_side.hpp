@@ -58,4 +58,31 @@ inline BatchSides<typename Lanes::Real> load_sides(const Args& k, std::size_t i)
   return s;
 }
 
+// The same values in two parts, for a loop that needs the velocities of some batches only: the
+// positions and radii of both sides (into xa..rb), then the velocities (vax..wbz).
+template <class Lanes, class Args>
+inline void load_positions(const Args& k, std::size_t i, BatchSides<typename Lanes::Real>& s) {
+  const auto ia = Lanes::index(k.a + i);
+  const auto ib = Lanes::index(k.b + i);
+  const ASide<Lanes> A(k.a + i, ia, k.columns);
+  s.xa = A.gather(k.x); s.ya = A.gather(k.y); s.za = A.gather(k.z); s.ra = A.gather(k.radius);
+  s.xb = Lanes::gather(k.x, ib); s.yb = Lanes::gather(k.y, ib); s.zb = Lanes::gather(k.z, ib);
+  s.rb = Lanes::gather(k.radius, ib);
+}
+
+template <class Lanes, bool Rotation, class Args>
+inline void load_velocities(const Args& k, std::size_t i, BatchSides<typename Lanes::Real>& s) {
+  using T = typename Lanes::Real;
+  const auto ia = Lanes::index(k.a + i);
+  const auto ib = Lanes::index(k.b + i);
+  const ASide<Lanes> A(k.a + i, ia, k.columns);
+  s.vax = A.gather(k.vx); s.vay = A.gather(k.vy); s.vaz = A.gather(k.vz);
+  s.vbx = Lanes::gather(k.vx, ib); s.vby = Lanes::gather(k.vy, ib); s.vbz = Lanes::gather(k.vz, ib);
+  s.wax = s.way = s.waz = s.wbx = s.wby = s.wbz = T(0.0);
+  if constexpr (Rotation) {
+    s.wax = A.gather(k.wx); s.way = A.gather(k.wy); s.waz = A.gather(k.wz);
+    s.wbx = Lanes::gather(k.wx, ib); s.wby = Lanes::gather(k.wy, ib); s.wbz = Lanes::gather(k.wz, ib);
+  }
+}
+
 }  // namespace asperity::kernels

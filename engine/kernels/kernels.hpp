@@ -7,6 +7,10 @@
 
 namespace asperity::kernels {
 
+// Pairs per stage of the pair loop (pair_loop.hpp): its scratch stays in L1. Blocks start at
+// multiples of it, so stage s holds pairs [s kPairStage, (s + 1) kPairStage).
+inline constexpr std::size_t kPairStage = 128;
+
 struct PairKernelArgs {
   const double* x; const double* y; const double* z;
   const double* vx; const double* vy; const double* vz;
@@ -27,6 +31,10 @@ struct PairKernelArgs {
   // null: every rest overlap is 0 and the column is not touched.
   double* rest = nullptr;
   bool stream = false;  // non-temporal record stores (pairs.cpp: record arrays past the caches)
+  // Per stage of kPairStage pairs (null: not kept): 1 where some pair of the stage touched in the
+  // last step, else 0, written by the kernel. A stage that did not touch is computed geometry
+  // first and its kinematics only if it touches now (pair_loop.hpp); the values are the same.
+  std::uint8_t* touched = nullptr;
 };
 
 using PairKernel = double (*)(const PairKernelArgs&, std::size_t begin, std::size_t end);

@@ -11,9 +11,6 @@
 
 namespace asperity::kernels {
 
-// Pairs per stage of the loop below: its scratch (8 columns) stays in L1.
-inline constexpr std::size_t kPairStage = 128;
-
 // The contact law of one pair is a chain of some 150 dependent operations (two square roots,
 // three divisions) in a body of ~400 instructions, more than the out-of-order window of a core
 // holds, so consecutive batches hardly overlap. The loop therefore runs in two passes over
@@ -33,24 +30,54 @@ double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
   using T = typename Lanes::Real;
   const LawParams<T> p{T(k.kn), T(k.ks), T(k.friction), T(k.dt)};
   T slip_sum(0.0);
-  alignas(64) double scratch[8][kPairStage];
+  alignas(64) double scratch[10][kPairStage];  // n U Vs phi; la lb on the split path
   for (std::size_t first = begin; first < end; first += kPairStage) {
     const std::size_t last = first + kPairStage < end ? first + kPairStage : end;
+    const std::size_t stage = first / kPairStage;
     T reach(0.0);  // the largest overlap of the stage (a NaN is not counted: it touches nothing)
-    for (std::size_t i = first; i < last; i += Lanes::size) {
-      const std::size_t j = i - first;
-      const BatchSides<T> q = load_sides<Lanes, Rotation>(k, i);
-      T nx, ny, nz, U, la, lb;
-      ball_ball_geometry(q.xa, q.ya, q.za, q.xb, q.yb, q.zb, q.ra, q.rb, nx, ny, nz, U, la, lb);
-      T vn, vsx, vsy, vsz, phi;
-      contact_kinematics<T, Rotation>(nx, ny, nz, la, lb, q.vax, q.vay, q.vaz, q.wax, q.way,
-                                      q.waz, q.vbx, q.vby, q.vbz, q.wbx, q.wby, q.wbz, p.dt, vn,
-                                      vsx, vsy, vsz, phi);
-      reach = select(U > reach, U, reach);
-      Lanes::store(scratch[0] + j, nx); Lanes::store(scratch[1] + j, ny);
-      Lanes::store(scratch[2] + j, nz); Lanes::store(scratch[3] + j, U);
-      Lanes::store(scratch[4] + j, vsx); Lanes::store(scratch[5] + j, vsy);
-      Lanes::store(scratch[6] + j, vsz); Lanes::store(scratch[7] + j, phi);
+    if (k.touched && !k.touched[stage]) {
+      // Nothing touched here in the last step: the geometry first, and the velocities and the
+      // kinematics only if something touches now (in a bonded specimen most stages never do).
+      for (std::size_t i = first; i < last; i += Lanes::size) {
+        const std::size_t j = i - first;
+        BatchSides<T> q;
+        load_positions<Lanes>(k, i, q);
+        T nx, ny, nz, U, la, lb;
+        ball_ball_geometry(q.xa, q.ya, q.za, q.xb, q.yb, q.zb, q.ra, q.rb, nx, ny, nz, U, la, lb);
+        reach = select(U > reach, U, reach);
+        Lanes::store(scratch[0] + j, nx); Lanes::store(scratch[1] + j, ny);
+        Lanes::store(scratch[2] + j, nz); Lanes::store(scratch[3] + j, U);
+        Lanes::store(scratch[8] + j, la); Lanes::store(scratch[9] + j, lb);
+      }
+      if (any(reach > T(0.0)))
+        for (std::size_t i = first; i < last; i += Lanes::size) {
+          const std::size_t j = i - first;
+          BatchSides<T> q;
+          load_velocities<Lanes, Rotation>(k, i, q);
+          T vn, vsx, vsy, vsz, phi;
+          contact_kinematics<T, Rotation>(
+              Lanes::load(scratch[0] + j), Lanes::load(scratch[1] + j), Lanes::load(scratch[2] + j),
+              Lanes::load(scratch[8] + j), Lanes::load(scratch[9] + j), q.vax, q.vay, q.vaz, q.wax,
+              q.way, q.waz, q.vbx, q.vby, q.vbz, q.wbx, q.wby, q.wbz, p.dt, vn, vsx, vsy, vsz, phi);
+          Lanes::store(scratch[4] + j, vsx); Lanes::store(scratch[5] + j, vsy);
+          Lanes::store(scratch[6] + j, vsz); Lanes::store(scratch[7] + j, phi);
+        }
+    } else {
+      for (std::size_t i = first; i < last; i += Lanes::size) {
+        const std::size_t j = i - first;
+        const BatchSides<T> q = load_sides<Lanes, Rotation>(k, i);
+        T nx, ny, nz, U, la, lb;
+        ball_ball_geometry(q.xa, q.ya, q.za, q.xb, q.yb, q.zb, q.ra, q.rb, nx, ny, nz, U, la, lb);
+        T vn, vsx, vsy, vsz, phi;
+        contact_kinematics<T, Rotation>(nx, ny, nz, la, lb, q.vax, q.vay, q.vaz, q.wax, q.way,
+                                        q.waz, q.vbx, q.vby, q.vbz, q.wbx, q.wby, q.wbz, p.dt, vn,
+                                        vsx, vsy, vsz, phi);
+        reach = select(U > reach, U, reach);
+        Lanes::store(scratch[0] + j, nx); Lanes::store(scratch[1] + j, ny);
+        Lanes::store(scratch[2] + j, nz); Lanes::store(scratch[3] + j, U);
+        Lanes::store(scratch[4] + j, vsx); Lanes::store(scratch[5] + j, vsy);
+        Lanes::store(scratch[6] + j, vsz); Lanes::store(scratch[7] + j, phi);
+      }
     }
     auto respond = [&](auto touching) __attribute__((always_inline)) {
       for (std::size_t i = first; i < last; i += Lanes::size) {
@@ -86,7 +113,9 @@ double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
           Lanes::template store_records<8>(k.out + 8 * i, record);
       }
     };
-    if (any(reach > T(0.0)))
+    const bool touches = any(reach > T(0.0));
+    if (k.touched) k.touched[stage] = touches;
+    if (touches)
       respond(std::true_type{});
     else
       respond(std::false_type{});

@@ -18,8 +18,9 @@ kernels::PairKernelArgs pair_kernel_args(State& s) {
           p.wx.data(), p.wy.data(), p.wz.data(), p.radius.data(), q.a.data(), q.b.data(),
           q.nx.data(), q.ny.data(), q.nz.data(), q.fsx.data(), q.fsy.data(), q.fsz.data(),
           q.out.data(), m.kn, m.ks, m.friction, s.dt, p.capacity,
-          s.rest_overlaps ? q.rest.data() : nullptr};
+          s.rest_overlaps ? q.rest.data() : nullptr, false, q.touched.data()};
 }
+static_assert(PairStore::kTouchStage == kernels::kPairStage);
 
 namespace {
 

@@ -40,6 +40,10 @@ struct PairStore {
   // reaches a pair through the incidence list in one line instead of seven columns
   // (perf/README.md). Outputs of the step: not carried by rebuilds nor saved.
   AVec<double> out;
+  // Per stage of kTouchStage pairs: whether one of them touched in the last pair stage (kernels.hpp,
+  // PairKernelArgs::touched); 1 where not known. Only chooses how the kernel computes the stage.
+  static constexpr std::size_t kTouchStage = 128;
+  std::vector<std::uint8_t> touched;
   // Set by the pair stage: the current normal forces and overlaps are in the records (slots 7
   // and 3), the fn and overlap columns are stale. Cleared where the columns are written.
   bool outputs_in_records = false;
@@ -70,6 +74,7 @@ struct PairStore {
   // The gather's columns are not saved: a store read from a checkpoint sizes them here.
   void size_outputs() {
     out.resize(kPairRecord * padded);
+    touched.assign(padded / kTouchStage + 1, 1);
     outputs_in_records = false;
   }
   // Padding entries: pair of two null particles, unit normal along x, no force.

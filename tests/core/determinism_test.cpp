@@ -188,7 +188,10 @@ TEST(Determinism, SimdKernelsEqualTheScalarReferenceBitwise) {
 // The pair kernels skip the law for a stage of pairs in which none touches (pair_loop.hpp): on
 // pairs of which whole stages miss (as in a bonded specimen, whose touching pairs became bonds)
 // and the others touch or miss at random, every kernel must give, pair by pair, the bits of the
-// law itself (contact_law.hpp applied to the one pair, the record formed as the kernel forms it).
+// law itself (contact_law.hpp applied to the one pair, the record formed as the kernel forms it),
+// whether it computes a stage in one pass or (a stage that did not touch in the last step:
+// PairKernelArgs::touched) the geometry first and the kinematics after; and it must say which
+// stages touch now.
 TEST(Determinism, PairKernelSkipsStagesOfNearMissesWithTheLawsBits) {
   const std::size_t pairs = 4096;
   std::vector<const kernels::KernelSet*> sets{&kernels::scalar_kernels()};
@@ -233,12 +236,22 @@ TEST(Determinism, PairKernelSkipsStagesOfNearMissesWithTheLawsBits) {
                                ny * fz - nz * fy, nz * fx - nx * fz, nx * fy - ny * fx, fn};
         std::copy(rec, rec + 8, law.out.begin() + std::ptrdiff_t(8 * k));
       }
+      std::vector<std::uint8_t> touching(pairs / kernels::kPairStage, 0);
+      for (std::size_t k = 0; k < pairs; ++k) touching[k / kernels::kPairStage] |= law.out[8 * k + 3] > 0;
       ASSERT_GT(misses, pairs / 2) << "most pairs miss";
       ASSERT_LT(misses, pairs - pairs / 8) << "some touch";
-      for (const kernels::KernelSet* ks : sets) {
+      for (const kernels::KernelSet* ks : sets)
+      for (int last_step : {-1, 0, 1}) {  // touched not kept; no stage touched; every stage did
         RandomPairs got = base;
-        const double slip = (rotation ? ks->pair : ks->pair_norot)(got.args(), 0, pairs);
-        const std::string what = std::string(ks->name) + (rotation ? " spin" : " no spin") + (rest ? " rest" : "");
+        std::vector<std::uint8_t> touched(pairs / kernels::kPairStage, std::uint8_t(last_step == 1));
+        auto args = got.args();
+        if (last_step >= 0) args.touched = touched.data();
+        const double slip = (rotation ? ks->pair : ks->pair_norot)(args, 0, pairs);
+        const std::string what = std::string(ks->name) + (rotation ? " spin" : " no spin") +
+                                 (rest ? " rest" : "") + " last step " + std::to_string(last_step);
+        if (last_step >= 0) {
+          EXPECT_EQ(touched, touching) << what;
+        }
         EXPECT_NEAR(slip, slip_law, 1e-12 * slip_law) << what;
         EXPECT_GT(slip_law, 0.0);
         EXPECT_EQ(0, std::memcmp(got.out.data(), law.out.data(), 8 * pairs * sizeof(double))) << what;
