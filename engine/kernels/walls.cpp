@@ -41,14 +41,6 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, cons
 }
 
 void bin_mesh(Mesh& mesh) {
-  mesh.normals.resize(mesh.triangles.size());
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    const auto& tri = mesh.triangles[t];
-    const Vec3 c = cross(mesh.vertices[tri[1]] - mesh.vertices[tri[0]],
-                         mesh.vertices[tri[2]] - mesh.vertices[tri[0]]);
-    const double l = norm(c);
-    mesh.normals[t] = l > 0 ? c / l : Vec3{0, 0, 0};
-  }
   TriangleBins& g = mesh.bins;
   Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
   double edge_sum = 0;
@@ -259,22 +251,6 @@ StageLoop wall_stage(State& s) {
       const auto& tri = mesh.triangles[wc.facet[k]];
       int feature;
       const Vec3 q = c - wall.displacement;
-      // A candidate whose centre is farther from the triangle's plane than its radius (with a
-      // margin far above the rounding of either distance) cannot touch it: it gets what the law
-      // gives a pair that does not touch (no force, no shear history) without the closest point.
-      // Its stored normal (the plane's, on the sphere's side) and overlap (R - plane distance,
-      // negative) stand in for the closest point's: without a shear force no later step reads
-      // more than their signs (carrying a zero force rotates nothing). Most candidates within the
-      // skin are such, and the closest point was 16 % of a joint's packing (perf/README.md).
-      const double h = dot(q - mesh.vertices[tri[0]], mesh.normals[wc.facet[k]]);
-      if (std::fabs(h) >= p.radius[i] * (1 + 1e-9)) {
-        const Vec3 n = mesh.normals[wc.facet[k]] * (h > 0 ? 1.0 : -1.0);
-        wc.nx[k] = n.x; wc.ny[k] = n.y; wc.nz[k] = n.z;
-        wc.fsx[k] = wc.fsy[k] = wc.fsz[k] = 0;
-        wc.fn[k] = 0;
-        wc.overlap[k] = p.radius[i] - std::fabs(h);
-        continue;
-      }
       const Vec3 cp = closest_point_on_triangle(q, mesh.vertices[tri[0]], mesh.vertices[tri[1]],
                                                 mesh.vertices[tri[2]], feature);
       const Vec3 dv = q - cp;

@@ -32,9 +32,6 @@ struct Mesh {
   // triangle sharing that feature is closer to the sphere (otherwise that triangle's face or
   // edge is the contact, and this one is its shadow).
   std::vector<std::int32_t> vertex_start, vertex_triangles;
-  // Unit normal of each triangle (zero for a degenerate one), set with the bins: a sphere whose
-  // centre lies farther than its radius from a triangle's plane cannot touch the triangle.
-  std::vector<Vec3> normals;
   TriangleBins bins;
 };
 
