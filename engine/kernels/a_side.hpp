@@ -40,26 +40,9 @@ struct BatchSides {
   T xb, yb, zb, rb, vbx, vby, vbz, wbx, wby, wbz;
 };
 
-template <class Lanes, bool Rotation, class Args>
-inline BatchSides<typename Lanes::Real> load_sides(const Args& k, std::size_t i) {
-  using T = typename Lanes::Real;
-  const auto ia = Lanes::index(k.a + i);
-  const auto ib = Lanes::index(k.b + i);
-  const ASide<Lanes> A(k.a + i, ia, k.columns);
-  BatchSides<T> s{A.gather(k.x), A.gather(k.y), A.gather(k.z), A.gather(k.radius),
-                  A.gather(k.vx), A.gather(k.vy), A.gather(k.vz), T(0.0), T(0.0), T(0.0),
-                  Lanes::gather(k.x, ib), Lanes::gather(k.y, ib), Lanes::gather(k.z, ib),
-                  Lanes::gather(k.radius, ib), Lanes::gather(k.vx, ib), Lanes::gather(k.vy, ib),
-                  Lanes::gather(k.vz, ib), T(0.0), T(0.0), T(0.0)};
-  if constexpr (Rotation) {
-    s.wax = A.gather(k.wx); s.way = A.gather(k.wy); s.waz = A.gather(k.wz);
-    s.wbx = Lanes::gather(k.wx, ib); s.wby = Lanes::gather(k.wy, ib); s.wbz = Lanes::gather(k.wz, ib);
-  }
-  return s;
-}
-
-// The same values in two parts, for a loop that needs the velocities of some batches only: the
-// positions and radii of both sides (into xa..rb), then the velocities (vax..wbz).
+// The positions and radii of both sides (into xa..rb), then their velocities (vax..wbz): apart
+// for a loop that needs the velocities of some batches only (pair_loop.hpp), together in
+// load_sides.
 template <class Lanes, class Args>
 inline void load_positions(const Args& k, std::size_t i, BatchSides<typename Lanes::Real>& s) {
   const auto ia = Lanes::index(k.a + i);
@@ -83,6 +66,14 @@ inline void load_velocities(const Args& k, std::size_t i, BatchSides<typename La
     s.wax = A.gather(k.wx); s.way = A.gather(k.wy); s.waz = A.gather(k.wz);
     s.wbx = Lanes::gather(k.wx, ib); s.wby = Lanes::gather(k.wy, ib); s.wbz = Lanes::gather(k.wz, ib);
   }
+}
+
+template <class Lanes, bool Rotation, class Args>
+inline BatchSides<typename Lanes::Real> load_sides(const Args& k, std::size_t i) {
+  BatchSides<typename Lanes::Real> s;
+  load_positions<Lanes>(k, i, s);
+  load_velocities<Lanes, Rotation>(k, i, s);
+  return s;
 }
 
 }  // namespace asperity::kernels

@@ -57,16 +57,12 @@ double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
     // record fx fy fz U cx cy cz 0 mx my mz 0 of each bond (store/bonds.hpp).
     const T ftot = fn + s.fbn;
     const T sx = s.fsx + s.fbsx, sy = s.fsy + s.fbsy, sz = s.fsz + s.fbsz;
-    if constexpr (Moments) {
-      const T record[12] = {ftot * nx + sx, ftot * ny + sy, ftot * nz + sz, U,
-                            ny * sz - nz * sy, nz * sx - nx * sz, nx * sy - ny * sx, T(0.0),
-                            s.mbn * nx + s.mbsx, s.mbn * ny + s.mbsy, s.mbn * nz + s.mbsz, T(0.0)};
-      Lanes::template store_records<12>(k.out + 12 * i, record);
-    } else {
-      const T record[8] = {ftot * nx + sx, ftot * ny + sy, ftot * nz + sz, U,
-                           ny * sz - nz * sy, nz * sx - nx * sz, nx * sy - ny * sx, T(0.0)};
-      Lanes::template store_records<8>(k.out + 8 * i, record);
-    }
+    // Without moments only the first eight values are stored.
+    constexpr int width = Moments ? 12 : 8;
+    const T record[12] = {ftot * nx + sx, ftot * ny + sy, ftot * nz + sz, U,
+                          ny * sz - nz * sy, nz * sx - nx * sz, nx * sy - ny * sx, T(0.0),
+                          s.mbn * nx + s.mbsx, s.mbn * ny + s.mbsy, s.mbn * nz + s.mbsz, T(0.0)};
+    Lanes::template store_records<width>(k.out + width * i, record);
   }
   return Lanes::sum(count);
 }
