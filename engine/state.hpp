@@ -43,6 +43,17 @@ struct Group {
   Vec3 impulse{0, 0, 0};  // sum of force x dt since the world was made or loaded (time averages)
 };
 
+// A rigid group's motion in the current step, for its members' moves and the ledgers
+// (bodies/groups.cpp, group_stages).
+struct GroupStep {
+  bool moves = false;  // the group has members (its motion was advanced)
+  Vec3 old_centre{0, 0, 0}, centre{0, 0, 0}, velocity{0, 0, 0}, angular_velocity{0, 0, 0};
+  Vec3 mean_angular_velocity{0, 0, 0}, theta{0, 0, 0};
+  bool spins = false;
+  double boundary = 0, damping = 0, gravity = 0;  // its terms of the ledgers
+  double kinetic = 0;                             // of its inert and idle members
+};
+
 // Cumulative ledgers of model.md 8 (kinetic and strain are computed on demand).
 struct Ledger {
   double friction = 0, damping = 0, boundary = 0, gravity = 0, released = 0;
@@ -149,6 +160,15 @@ struct State {
 
   std::vector<double> pair_block_slip;
   std::vector<ParticleBlockResult> particle_blocks;
+  // The group stages (bodies/groups.cpp): the members moved every step (busy members of lazy
+  // groups, all members of the others) in slots by group (group g: moved_start[g] to
+  // moved_start[g + 1]) and member order, their slots by particle block (split_idle); per group
+  // its motion in this step, per slot the member's kinetic energy.
+  std::vector<std::int32_t> moved_particle;
+  std::vector<std::size_t> moved_start;
+  Incidence block_moved;
+  std::vector<GroupStep> group_steps;
+  std::vector<double> member_kinetic;
 };
 
 // Stages of one step (engine/step.cpp runs them in this order).
@@ -181,7 +201,15 @@ void refresh_bond_topology(State& s);   // kernels/bonds.cpp: incidence, partner
 void build_incidence(std::size_t particles, const std::int64_t* a, const std::int64_t* b,
                      std::size_t count, Incidence& inc);
 void gather_and_integrate(State& s);    // kernels/integrate.cpp
-void advance_groups(State& s);          // bodies/groups.cpp
+// Stage `groups` in three loops that run in the step's parallel region after the gather:
+// `servo` (the servo's stiffness, one block, while a servo acts), `motion` (one block per group:
+// its force and torque summed in member order, its degrees of freedom advanced) and `moves` (the
+// members moved, by particle block, on the thread that gathered the block); moves' finish adds the ledgers and kinetic energy in the
+// order of a serial loop over groups and members, so the results are bitwise those of one.
+struct GroupStages {
+  StageLoop servo, motion, moves;
+};
+GroupStages group_stages(State& s);     // bodies/groups.cpp; empty stages without groups
 double estimate_critical_dt(const State& s);  // step.cpp
 Energies compute_energies(const State& s);    // step.cpp
 void step_once(State& s);               // step.cpp

@@ -28,136 +28,201 @@ Vec3 rotate(const Vec3& r, const Vec3& theta) {
 }
 }  // namespace
 
-void advance_groups(State& s) {
-  ParticleStore& p = s.p;
+namespace {
+
+// The motion of group gi in this step (stage `motion` of group_stages): its members' force and
+// torque summed in member order, each degree of freedom advanced by its mode, the centre moved.
+// What its members' moves need, and its terms of the ledgers, go to s.group_steps[gi].
+void advance_group_motion(State& s, std::size_t gi) {
+  Group& grp = s.groups[gi];
+  GroupStep& out = s.group_steps[gi];
+  out = GroupStep{};
+  if (grp.members.empty()) return;
+  const ParticleStore& p = s.p;
   const double dt = s.dt;
   const Vec3 g = s.settings.gravity;
-  double kinetic = 0;
-  for (Group& grp : s.groups) {
-    if (grp.members.empty()) continue;
-    const double alpha = grp.motion.damping >= 0 ? grp.motion.damping : s.settings.local_damping;
-    // Idle members of a lazy group carry no force (split_idle): summing and moving the busy ones
-    // is the whole group.
-    const std::vector<std::int32_t>& moved = grp.lazy ? grp.busy : grp.members;
-    Vec3 F = grp.applied, T{0, 0, 0};
-    for (std::int32_t i : moved) {
-      const Vec3 f{p.fx[i], p.fy[i], p.fz[i]};
-      const Vec3 r = Vec3{p.x[i], p.y[i], p.z[i]} - grp.centre;
-      F += f;
-      T += Vec3{p.tx[i], p.ty[i], p.tz[i]} + cross(r, f);
-    }
-    grp.force = F;
-    grp.torque = T;
-    grp.impulse += F * dt;
-    const double M = grp.mass;
+  const double alpha = grp.motion.damping >= 0 ? grp.motion.damping : s.settings.local_damping;
+  // Idle members of a lazy group carry no force (split_idle): summing and moving the busy ones
+  // is the whole group.
+  const std::vector<std::int32_t>& moved = grp.lazy ? grp.busy : grp.members;
+  Vec3 F = grp.applied, T{0, 0, 0};
+  for (std::int32_t i : moved) {
+    const Vec3 f{p.fx[i], p.fy[i], p.fz[i]};
+    const Vec3 r = Vec3{p.x[i], p.y[i], p.z[i]} - grp.centre;
+    F += f;
+    T += Vec3{p.tx[i], p.ty[i], p.tz[i]} + cross(r, f);
+  }
+  grp.force = F;
+  grp.torque = T;
+  grp.impulse += F * dt;
+  const double M = grp.mass;
 
-    // Translation, per axis.
-    double V[3] = {grp.velocity.x, grp.velocity.y, grp.velocity.z};
-    const double Fk[3] = {F.x, F.y, F.z}, gk[3] = {g.x, g.y, g.z};
-    const double Vp[3] = {grp.motion.velocity.x, grp.motion.velocity.y, grp.motion.velocity.z};
-    double Vn[3] = {0, 0, 0};
-    double agent_work = 0, damping_work = 0;
-    for (int k = 0; k < 3; ++k) {
-      switch (grp.motion.translation[k]) {
-        case Dof::free: {
-          const double fd = -alpha * std::fabs(Fk[k] + M * gk[k]) * sign(V[k]);  // unbalanced
-          Vn[k] = V[k] + (Fk[k] + fd) / M * dt + gk[k] * dt;
-          damping_work -= fd * 0.5 * (V[k] + Vn[k]) * dt;
-          break;
-        }
-        case Dof::fixed:
-        case Dof::velocity:
-        case Dof::servo: {
-          if (grp.motion.translation[k] == Dof::servo) {
-            // model.md 7: v = clamp(G (F - F_target), -vmax, vmax), target moving with CNS;
-            // with integral_time Ti > 0, v = G (e + I / Ti), I = int e dt, integrated only while
-            // the velocity is not clamped (no wind-up while the platen runs at vmax).
-            const Servo& sv = grp.motion.servo[k];
-            const double shift = grp.centre[k] - grp.servo_origin[k];
-            const double target = sv.target_force + sv.stiffness * shift;
-            const double error = Fk[k] - target;
-            // Automatic gain: a body out of contact counts as meeting one contact (as in the
-            // time-step estimate [3-30]): it approaches at most `relaxation` x (its force error /
-            // kn) per step, so the first contact cannot be overshot by more than the target load
-            // needs. (kn > 0 and relaxation > 0 are enforced, so the gain is always positive.)
-            const double gain =
-                sv.gain > 0 ? sv.gain : sv.relaxation / (std::max(grp.contact_stiffness, s.settings.contact.kn) * dt);
-            double& integral = grp.servo_integral[k];
-            if (sv.integral_time > 0) {
-              const double trial = integral + error * dt;
-              if (std::fabs(gain * (error + trial / sv.integral_time)) <= sv.max_velocity) integral = trial;
-            }
-            const double v = gain * (error + (sv.integral_time > 0 ? integral / sv.integral_time : 0.0));
-            Vn[k] = std::clamp(v, -sv.max_velocity, sv.max_velocity);
-          } else {
-            Vn[k] = grp.motion.translation[k] == Dof::fixed ? 0.0 : Vp[k];
+  // Translation, per axis.
+  double V[3] = {grp.velocity.x, grp.velocity.y, grp.velocity.z};
+  const double Fk[3] = {F.x, F.y, F.z}, gk[3] = {g.x, g.y, g.z};
+  const double Vp[3] = {grp.motion.velocity.x, grp.motion.velocity.y, grp.motion.velocity.z};
+  double Vn[3] = {0, 0, 0};
+  double agent_work = 0, damping_work = 0;
+  for (int k = 0; k < 3; ++k) {
+    switch (grp.motion.translation[k]) {
+      case Dof::free: {
+        const double fd = -alpha * std::fabs(Fk[k] + M * gk[k]) * sign(V[k]);  // unbalanced
+        Vn[k] = V[k] + (Fk[k] + fd) / M * dt + gk[k] * dt;
+        damping_work -= fd * 0.5 * (V[k] + Vn[k]) * dt;
+        break;
+      }
+      case Dof::fixed:
+      case Dof::velocity:
+      case Dof::servo: {
+        if (grp.motion.translation[k] == Dof::servo) {
+          // model.md 7: v = clamp(G (F - F_target), -vmax, vmax), target moving with CNS;
+          // with integral_time Ti > 0, v = G (e + I / Ti), I = int e dt, integrated only while
+          // the velocity is not clamped (no wind-up while the platen runs at vmax).
+          const Servo& sv = grp.motion.servo[k];
+          const double shift = grp.centre[k] - grp.servo_origin[k];
+          const double target = sv.target_force + sv.stiffness * shift;
+          const double error = Fk[k] - target;
+          // Automatic gain: a body out of contact counts as meeting one contact (as in the
+          // time-step estimate [3-30]): it approaches at most `relaxation` x (its force error /
+          // kn) per step, so the first contact cannot be overshot by more than the target load
+          // needs. (kn > 0 and relaxation > 0 are enforced, so the gain is always positive.)
+          const double gain =
+              sv.gain > 0 ? sv.gain : sv.relaxation / (std::max(grp.contact_stiffness, s.settings.contact.kn) * dt);
+          double& integral = grp.servo_integral[k];
+          if (sv.integral_time > 0) {
+            const double trial = integral + error * dt;
+            if (std::fabs(gain * (error + trial / sv.integral_time)) <= sv.max_velocity) integral = trial;
           }
-          const double agent = M * (Vn[k] - V[k]) / dt - (Fk[k] + M * gk[k]);
-          agent_work += agent * 0.5 * (V[k] + Vn[k]) * dt;
-          break;
+          const double v = gain * (error + (sv.integral_time > 0 ? integral / sv.integral_time : 0.0));
+          Vn[k] = std::clamp(v, -sv.max_velocity, sv.max_velocity);
+        } else {
+          Vn[k] = grp.motion.translation[k] == Dof::fixed ? 0.0 : Vp[k];
         }
+        const double agent = M * (Vn[k] - V[k]) / dt - (Fk[k] + M * gk[k]);
+        agent_work += agent * 0.5 * (V[k] + Vn[k]) * dt;
+        break;
       }
-    }
-    const Vec3 Vnew{Vn[0], Vn[1], Vn[2]};
-    const Vec3 Vmid = (grp.velocity + Vnew) * 0.5;
-
-    // Rotation, all axes together.
-    Vec3 W = grp.angular_velocity, Wnew{0, 0, 0};
-    if (grp.motion.rotation == Dof::fixed) {
-      Wnew = {0, 0, 0};
-    } else {
-      Eigen::Matrix3d I = Eigen::Matrix3d::Zero();
-      for (std::int32_t i : grp.members) {
-        const Eigen::Vector3d r(p.x[i] - grp.centre.x, p.y[i] - grp.centre.y, p.z[i] - grp.centre.z);
-        I += p.mass[i] * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose()) +
-             p.inertia[i] * Eigen::Matrix3d::Identity();
-      }
-      if (grp.motion.rotation == Dof::velocity) {
-        Wnew = grp.motion.angular_velocity;
-        const Eigen::Vector3d dW(Wnew.x - W.x, Wnew.y - W.y, Wnew.z - W.z);
-        const Eigen::Vector3d agent = I * dW / dt - Eigen::Vector3d(T.x, T.y, T.z);
-        agent_work += Vec3{agent.x(), agent.y(), agent.z()} == Vec3{} ? 0.0
-                      : dot(Vec3{agent.x(), agent.y(), agent.z()}, (W + Wnew) * 0.5) * dt;
-      } else {
-        const Vec3 Td{-alpha * std::fabs(T.x) * sign(W.x), -alpha * std::fabs(T.y) * sign(W.y),
-                      -alpha * std::fabs(T.z) * sign(W.z)};
-        const Eigen::Vector3d dW = I.ldlt().solve(Eigen::Vector3d(T.x + Td.x, T.y + Td.y, T.z + Td.z)) * dt;
-        Wnew = W + Vec3{dW.x(), dW.y(), dW.z()};
-        damping_work -= dot(Td, (W + Wnew) * 0.5) * dt;
-      }
-    }
-
-    if (s.settings.track_energy) {
-      s.ledger.boundary += agent_work + dot(grp.applied, Vmid) * dt;
-      s.ledger.damping += damping_work;
-      s.ledger.gravity += M * dot(g, Vmid) * dt;
-    }
-
-    // Move the members rigidly.
-    const Vec3 old_centre = grp.centre;
-    grp.centre += Vnew * dt;
-    grp.velocity = Vnew;
-    grp.angular_velocity = Wnew;
-    const Vec3 theta = Wnew * dt;
-    const bool spins = !(Wnew == Vec3{});
-    // Inert members: only the shift is recorded; they are moved when someone reads them.
-    grp.inert_shift += Vnew * dt;
-    grp.idle_shift += Vnew * dt;
-    kinetic += 0.5 * (grp.inert_mass + grp.idle_mass) * dot(Vmid, Vmid);
-    for (std::int32_t i : moved) {
-      Vec3 r = Vec3{p.x[i], p.y[i], p.z[i]} - old_centre;
-      if (spins) r = rotate(r, theta);
-      const Vec3 x = grp.centre + r;
-      const Vec3 v = Vnew + cross(Wnew, r);
-      const Vec3 vmid = (v + Vec3{p.vx[i], p.vy[i], p.vz[i]}) * 0.5;
-      const Vec3 wmid = (Wnew + W) * 0.5;
-      kinetic += 0.5 * p.mass[i] * dot(vmid, vmid) + 0.5 * p.inertia[i] * dot(wmid, wmid);
-      p.x[i] = x.x; p.y[i] = x.y; p.z[i] = x.z;
-      p.vx[i] = v.x; p.vy[i] = v.y; p.vz[i] = v.z;
-      p.wx[i] = Wnew.x; p.wy[i] = Wnew.y; p.wz[i] = Wnew.z;
     }
   }
-  s.kinetic_at_step = kinetic;  // the free particles' share is added in bookkeeping
+  const Vec3 Vnew{Vn[0], Vn[1], Vn[2]};
+  const Vec3 Vmid = (grp.velocity + Vnew) * 0.5;
+
+  // Rotation, all axes together.
+  Vec3 W = grp.angular_velocity, Wnew{0, 0, 0};
+  if (grp.motion.rotation == Dof::fixed) {
+    Wnew = {0, 0, 0};
+  } else {
+    Eigen::Matrix3d I = Eigen::Matrix3d::Zero();
+    for (std::int32_t i : grp.members) {
+      const Eigen::Vector3d r(p.x[i] - grp.centre.x, p.y[i] - grp.centre.y, p.z[i] - grp.centre.z);
+      I += p.mass[i] * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose()) +
+           p.inertia[i] * Eigen::Matrix3d::Identity();
+    }
+    if (grp.motion.rotation == Dof::velocity) {
+      Wnew = grp.motion.angular_velocity;
+      const Eigen::Vector3d dW(Wnew.x - W.x, Wnew.y - W.y, Wnew.z - W.z);
+      const Eigen::Vector3d agent = I * dW / dt - Eigen::Vector3d(T.x, T.y, T.z);
+      agent_work += Vec3{agent.x(), agent.y(), agent.z()} == Vec3{} ? 0.0
+                    : dot(Vec3{agent.x(), agent.y(), agent.z()}, (W + Wnew) * 0.5) * dt;
+    } else {
+      const Vec3 Td{-alpha * std::fabs(T.x) * sign(W.x), -alpha * std::fabs(T.y) * sign(W.y),
+                    -alpha * std::fabs(T.z) * sign(W.z)};
+      const Eigen::Vector3d dW = I.ldlt().solve(Eigen::Vector3d(T.x + Td.x, T.y + Td.y, T.z + Td.z)) * dt;
+      Wnew = W + Vec3{dW.x(), dW.y(), dW.z()};
+      damping_work -= dot(Td, (W + Wnew) * 0.5) * dt;
+    }
+  }
+
+  // Its terms of the ledgers, added in group order after the region (moves' finish).
+  out.moves = true;
+  out.boundary = agent_work + dot(grp.applied, Vmid) * dt;
+  out.damping = damping_work;
+  out.gravity = M * dot(g, Vmid) * dt;
+  out.kinetic = 0.5 * (grp.inert_mass + grp.idle_mass) * dot(Vmid, Vmid);
+
+  // What the rigid moves of its members need (stage `moves`).
+  out.old_centre = grp.centre;
+  grp.centre += Vnew * dt;
+  out.centre = grp.centre;
+  grp.velocity = Vnew;
+  grp.angular_velocity = Wnew;
+  out.velocity = Vnew;
+  out.angular_velocity = Wnew;
+  out.mean_angular_velocity = (Wnew + W) * 0.5;
+  out.theta = Wnew * dt;
+  out.spins = !(Wnew == Vec3{});
+  // Inert members: only the shift is recorded; they are moved when someone reads them.
+  grp.inert_shift += Vnew * dt;
+  grp.idle_shift += Vnew * dt;
+}
+
+// Moves the moved members of particle block blk (stage `moves`) rigidly with their groups and
+// keeps each one's kinetic energy for the finish, which sums them in member order. By particle
+// block, so that the thread which gathered a block's particles (and holds their lines) moves them.
+void move_members(State& s, std::size_t blk) {
+  ParticleStore& p = s.p;
+  for (std::int32_t e = s.block_moved.start[blk]; e < s.block_moved.start[blk + 1]; ++e) {
+    const std::size_t slot = std::size_t(s.block_moved.entry[e]);
+    const std::int32_t i = s.moved_particle[slot];
+    const GroupStep& st = s.group_steps[std::size_t(p.group[i])];
+    Vec3 r = Vec3{p.x[i], p.y[i], p.z[i]} - st.old_centre;
+    if (st.spins) r = rotate(r, st.theta);
+    const Vec3 x = st.centre + r;
+    const Vec3 v = st.velocity + cross(st.angular_velocity, r);
+    const Vec3 vmid = (v + Vec3{p.vx[i], p.vy[i], p.vz[i]}) * 0.5;
+    const Vec3 wmid = st.mean_angular_velocity;
+    s.member_kinetic[slot] = 0.5 * p.mass[i] * dot(vmid, vmid) + 0.5 * p.inertia[i] * dot(wmid, wmid);
+    p.x[i] = x.x; p.y[i] = x.y; p.z[i] = x.z;
+    p.vx[i] = v.x; p.vy[i] = v.y; p.vz[i] = v.z;
+    p.wx[i] = st.angular_velocity.x; p.wy[i] = st.angular_velocity.y; p.wz[i] = st.angular_velocity.z;
+  }
+}
+
+bool any_servo(const State& s) {
+  for (const Group& g : s.groups)
+    for (Dof d : g.motion.translation)
+      if (d == Dof::servo) return true;
+  return false;
+}
+
+}  // namespace
+
+GroupStages group_stages(State& s) {
+  GroupStages st;
+  if (s.groups.empty()) return st;
+  s.group_steps.assign(s.groups.size(), GroupStep{});
+  s.member_kinetic.resize(s.moved_particle.size());
+  if (any_servo(s)) {
+    st.servo.blocks = 1;  // reads the force stages' overlaps only: no barrier of its own
+    st.servo.run = [&s](std::size_t) { update_servo_stiffness(s); };
+  }
+  st.motion.blocks = s.groups.size();
+  st.motion.after_barrier = true;  // every member's force gathered, the servo's stiffness known
+  st.motion.run = [&s](std::size_t g) { advance_group_motion(s, g); };
+  st.moves.blocks = s.block_moved.start.empty() ? 0 : s.block_moved.start.size() - 1;
+  st.moves.after_barrier = true;  // every group's motion
+  st.moves.run = [&s](std::size_t blk) { move_members(s, blk); };
+  st.moves.finish = [&s] {
+    // In the order of the serial loop over groups and members these stages replace: per group its
+    // ledger terms, its inert and idle members' kinetic energy, then its moved members' (the
+    // slots run over the groups in order, each group's members in their order).
+    double kinetic = 0;
+    std::size_t slot = 0;
+    for (std::size_t g = 0; g < s.groups.size(); ++g) {
+      const GroupStep& gs = s.group_steps[g];
+      if (!gs.moves) continue;
+      if (s.settings.track_energy) {
+        s.ledger.boundary += gs.boundary;
+        s.ledger.damping += gs.damping;
+        s.ledger.gravity += gs.gravity;
+      }
+      kinetic += gs.kinetic;
+      const std::size_t end = s.moved_start[g + 1];
+      for (; slot < end; ++slot) kinetic += s.member_kinetic[slot];
+    }
+    s.kinetic_at_step = kinetic;  // the free particles' share is added in bookkeeping
+  };
+  return st;
 }
 
 // The servo gain G = relaxation / (K dt) needs the stiffness K the group meets now: computed every
@@ -268,6 +333,24 @@ void split_idle(State& s) {
         if (!p.inert[i] && !s.idle[i]) bb.entry.push_back(std::int64_t(i));
     bb.start[blk + 1] = std::int32_t(bb.entry.size());
   }
+  // The members the group stages move each step (busy ones of lazy groups, all of the others),
+  // in slots by group and member order, and the slots by particle block (group_stages).
+  s.moved_particle.clear();
+  s.moved_start.assign(s.groups.size() + 1, 0);
+  for (std::size_t g = 0; g < s.groups.size(); ++g) {
+    const Group& grp = s.groups[g];
+    if (!grp.members.empty())
+      for (std::int32_t i : grp.lazy ? grp.busy : grp.members) s.moved_particle.push_back(i);
+    s.moved_start[g + 1] = s.moved_particle.size();
+  }
+  Incidence& bm = s.block_moved;
+  bm.start.assign(blocks + 1, 0);
+  for (std::int32_t i : s.moved_particle) ++bm.start[std::size_t(i) / kParticleBlock + 1];
+  for (std::size_t blk = 0; blk < blocks; ++blk) bm.start[blk + 1] += bm.start[blk];
+  bm.entry.assign(s.moved_particle.size(), 0);
+  std::vector<std::int32_t> fill(bm.start.begin(), bm.start.end() - 1);
+  for (std::size_t slot = 0; slot < s.moved_particle.size(); ++slot)
+    bm.entry[std::size_t(fill[std::size_t(s.moved_particle[slot]) / kParticleBlock]++)] = std::int64_t(slot);
   s.idle_valid = true;
 }
 
