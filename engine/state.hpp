@@ -163,12 +163,14 @@ struct State {
   // The group stages (bodies/groups.cpp): the members moved every step (busy members of lazy
   // groups, all members of the others) in slots by group (group g: moved_start[g] to
   // moved_start[g + 1]) and member order, their slots by particle block (split_idle); per group
-  // its motion in this step, per slot the member's kinetic energy.
+  // its motion in this step, per slot the member's kinetic energy, squared displacement since
+  // the last build and whether its new position is finite.
   std::vector<std::int32_t> moved_particle;
   std::vector<std::size_t> moved_start;
   Incidence block_moved;
   std::vector<GroupStep> group_steps;
-  std::vector<double> member_kinetic;
+  std::vector<double> member_kinetic, member_disp2;
+  std::vector<std::uint8_t> member_finite;
 };
 
 // Stages of one step (engine/step.cpp runs them in this order).

@@ -71,12 +71,16 @@ void bookkeep(State& s) {
   };
   if (!(max_disp2 == max_disp2)) first = max_disp2;  // NaN: rebuild, the health check reports it
   else if (max_disp2 > 0) body(std::sqrt(max_disp2)), body(std::sqrt(max_disp2));  // two free particles
-  for (const Group& g : s.groups) {
+  for (std::size_t gi = 0; gi < s.groups.size(); ++gi) {
+    const Group& g = s.groups[gi];
     double d2 = 0;
-    for (std::int32_t i : g.lazy ? g.busy : g.members) {
-      const double dx = p.x[i] - p.x0[i], dy = p.y[i] - p.y0[i], dz = p.z[i] - p.z0[i];
-      d2 = std::max(d2, dx * dx + dy * dy + dz * dz);
-      if (!std::isfinite(p.x[i] + p.y[i] + p.z[i])) health_error(s, "non-finite position", i, "x", p.x[i]);
+    // The moved members in member order, as the moves stage left them (bodies/groups.cpp).
+    for (std::size_t slot = s.moved_start[gi]; slot < s.moved_start[gi + 1]; ++slot) {
+      d2 = std::max(d2, s.member_disp2[slot]);
+      if (!s.member_finite[slot]) {
+        const std::int32_t i = s.moved_particle[slot];
+        health_error(s, "non-finite position", i, "x", p.x[i]);
+      }
     }
     double d = std::sqrt(d2);
     if (g.lazy && g.busy.size() < g.members.size()) {

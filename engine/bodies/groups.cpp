@@ -157,7 +157,8 @@ void advance_group_motion(State& s, std::size_t gi) {
 }
 
 // Moves the moved members of particle block blk (stage `moves`) rigidly with their groups and
-// keeps each one's kinetic energy for the finish, which sums them in member order. By particle
+// keeps each one's kinetic energy for the finish, which sums them in member order, and its
+// displacement since the build and whether its position is finite for bookkeep. By particle
 // block, so that the thread which gathered a block's particles (and holds their lines) moves them.
 void move_members(State& s, std::size_t blk) {
   ParticleStore& p = s.p;
@@ -175,6 +176,10 @@ void move_members(State& s, std::size_t blk) {
     p.x[i] = x.x; p.y[i] = x.y; p.z[i] = x.z;
     p.vx[i] = v.x; p.vy[i] = v.y; p.vz[i] = v.z;
     p.wx[i] = st.angular_velocity.x; p.wy[i] = st.angular_velocity.y; p.wz[i] = st.angular_velocity.z;
+    // For the rebuild criterion and the health check (bookkeep), while the member is at hand.
+    const double dx = x.x - p.x0[i], dy = x.y - p.y0[i], dz = x.z - p.z0[i];
+    s.member_disp2[slot] = dx * dx + dy * dy + dz * dz;
+    s.member_finite[slot] = std::isfinite(x.x + x.y + x.z);
   }
 }
 
@@ -192,6 +197,8 @@ GroupStages group_stages(State& s) {
   if (s.groups.empty()) return st;
   s.group_steps.assign(s.groups.size(), GroupStep{});
   s.member_kinetic.resize(s.moved_particle.size());
+  s.member_disp2.resize(s.moved_particle.size());
+  s.member_finite.resize(s.moved_particle.size());
   if (any_servo(s)) {
     st.servo.blocks = 1;  // reads the force stages' overlaps only: no barrier of its own
     st.servo.run = [&s](std::size_t) { update_servo_stiffness(s); };

@@ -2,7 +2,10 @@
 // excluded; boundary work of the agent that drives them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <string>
 #include <random>
 
 #include "asperity/world.hpp"
@@ -226,6 +229,26 @@ TEST(Groups, DrivenGroupEnergyBalance) {
   ASSERT_GT(input, 0);
   EXPECT_LT(std::fabs(e.balance_error(e0)), 0.01 * input);
   EXPECT_GT(w.group_force(g).z, 0) << "the column pushes back";
+}
+
+// A group whose members run away stops the run naming one of them (step.cpp, bookkeep, from the
+// moves stage's record of each moved member): a free slab whose members each carry the largest
+// finite force has an infinite resultant, hence a position that is not finite after the first step.
+TEST(Groups, ARunawayGroupStopsTheRunNamingAMember) {
+  World w;
+  const auto ids = slab(w, 4, 0, 5e-4);
+  const int g = w.add_group(ids, GroupMotion{});
+  for (auto id : ids) w.set_applied_force(id, {std::numeric_limits<double>::max(), 0, 0});
+  try {
+    w.cycle(2);
+    FAIL() << "a group at a non-finite position must stop the run";
+  } catch (const HealthError& e) {
+    EXPECT_EQ(e.step, 1u);
+    EXPECT_EQ(e.quantity, "x");
+    EXPECT_NE(std::find(ids.begin(), ids.end(), e.particle_id), ids.end()) << e.particle_id;
+    EXPECT_NE(std::string(e.what()).find("non-finite position"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::isfinite(w.group_position(g).x));
 }
 
 TEST(Groups, BadInputIsRefusedWithAReason) {
