@@ -162,17 +162,25 @@ void advance_group_motion(State& s, std::size_t gi) {
 // block, so that the thread which gathered a block's particles (and holds their lines) moves them.
 void move_members(State& s, std::size_t blk) {
   ParticleStore& p = s.p;
+  // A block's slots ascend, and the slots run over the groups in order: the group of a slot is
+  // found by walking the groups' slot ranges.
+  std::size_t g = 0;
   for (std::int32_t e = s.block_moved.start[blk]; e < s.block_moved.start[blk + 1]; ++e) {
     const std::size_t slot = std::size_t(s.block_moved.entry[e]);
+    while (slot >= s.moved_start[g + 1]) ++g;
     const std::int32_t i = s.moved_particle[slot];
-    const GroupStep& st = s.group_steps[std::size_t(p.group[i])];
+    const GroupStep& st = s.group_steps[g];
     Vec3 r = Vec3{p.x[i], p.y[i], p.z[i]} - st.old_centre;
     if (st.spins) r = rotate(r, st.theta);
     const Vec3 x = st.centre + r;
     const Vec3 v = st.velocity + cross(st.angular_velocity, r);
     const Vec3 vmid = (v + Vec3{p.vx[i], p.vy[i], p.vz[i]}) * 0.5;
     const Vec3 wmid = st.mean_angular_velocity;
-    s.member_kinetic[slot] = 0.5 * p.mass[i] * dot(vmid, vmid) + 0.5 * p.inertia[i] * dot(wmid, wmid);
+    double kinetic = 0.5 * p.mass[i] * dot(vmid, vmid);
+    // The rotational term is an exact +0 where the group does not turn (adding it changes no bit
+    // of the non-negative translational one): its inertia is not read then.
+    if (!(wmid == Vec3{})) kinetic += 0.5 * p.inertia[i] * dot(wmid, wmid);
+    s.member_kinetic[slot] = kinetic;
     p.x[i] = x.x; p.y[i] = x.y; p.z[i] = x.z;
     p.vx[i] = v.x; p.vy[i] = v.y; p.vz[i] = v.z;
     p.wx[i] = st.angular_velocity.x; p.wy[i] = st.angular_velocity.y; p.wz[i] = st.angular_velocity.z;
