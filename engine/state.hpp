@@ -206,8 +206,9 @@ void gather_and_integrate(State& s);    // kernels/integrate.cpp
 // Stage `groups` in three loops that run in the step's parallel region after the gather:
 // `servo` (the servo's stiffness, one block, while a servo acts), `motion` (one block per group:
 // its force and torque summed in member order, its degrees of freedom advanced) and `moves` (the
-// members moved, by particle block, on the thread that gathered the block); moves' finish adds the ledgers and kinetic energy in the
-// order of a serial loop over groups and members, so the results are bitwise those of one.
+// members moved, by particle block, on the thread that gathered the block). The finish of moves
+// adds the ledgers and kinetic energy in the order of a serial loop over groups and members, so
+// the results are bitwise those of one.
 struct GroupStages {
   StageLoop servo, motion, moves;
 };
