@@ -207,9 +207,16 @@ function M.scale(world, first, last, factor)
 end
 
 -- Mean of box_wall_stresses over the walls of `box` (Pa).
+-- Summed in a fixed order: pairs() visits string keys in an order that Lua 5.4 seeds per process,
+-- which made the last digit of the mean (and the REV's stress installation, which compares it
+-- with its target) differ between two runs of the same script.
+local BOX_FACES = {"x_min", "x_max", "y_min", "y_max", "bottom", "top"}
 function M.mean_box_wall_stress(world, box, lo, hi)
+  local stresses = M.box_wall_stresses(world, box, lo, hi)
   local s, n = 0, 0
-  for _, v in pairs(M.box_wall_stresses(world, box, lo, hi)) do s, n = s + v, n + 1 end
+  for _, name in ipairs(BOX_FACES) do
+    if stresses[name] then s, n = s + stresses[name], n + 1 end
+  end
   return s / n
 end
 
