@@ -120,7 +120,7 @@ local T = P.thickness
 
 -- 2. The specimen: packed, bonded, relaxed halves (cached) ---------------------------------
 local key = ("%s_%s_n%d_h%.6g_T%.6g_p%.4g_s%d_g%.6g_k%d"):format(
-  P.surface_file ~= "" and P.surface_file:gsub("[^%w]", "_") or P.surface, "v4", n, h, T,
+  P.surface_file ~= "" and P.surface_file:gsub("[^%w]", "_") or P.surface, "v5", n, h, T,
   P.porosity, P.seed, P.gap, P.pack_steps) .. (P.wall_friction ~= mat.contact.friction and ("_f%.3g"):format(P.wall_friction) or "") ..
   (P.packing_stress > 0 and ("_ps%.3g"):format(P.packing_stress) or "") .. (P.stress_free_bonds and "_sf" or "")
 local cache_file = P.cache .. "/joint_" .. key .. ".h5"

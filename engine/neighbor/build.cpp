@@ -213,6 +213,7 @@ void reorder(State& s, const CellGrid& g) {
     ws.nx[k] = w.nx[o]; ws.ny[k] = w.ny[o]; ws.nz[k] = w.nz[o];
     ws.fsx[k] = w.fsx[o]; ws.fsy[k] = w.fsy[o]; ws.fsz[k] = w.fsz[o];
     ws.fn[k] = w.fn[o]; ws.overlap[k] = w.overlap[o];
+    if (w.distance.size() == w.n) ws.distance[k] = w.distance[o];
   }
   w = std::move(ws);
 
@@ -376,7 +377,11 @@ void build_wall_contacts(State& s) {
   const ParticleStore& p = s.p;
   const std::size_t n = p.n;
   auto& walls = s.walls.walls;
-  std::vector<std::vector<std::array<std::int32_t, 2>>> cand(n);  // (wall, facet) per particle
+  struct Candidate {
+    std::int32_t wall, facet;
+    double distance;  // centre to the triangle (mesh); 0 for a plane
+  };
+  std::vector<std::vector<Candidate>> cand(n);  // per particle
 #pragma omp parallel num_threads(thread_count(s))
   {
     std::vector<std::int32_t> tris;
@@ -390,7 +395,7 @@ void build_wall_contacts(State& s) {
         if (wall.removed) continue;
         if (wall.kind == Wall::Kind::plane) {
           const double d = dot(c - (wall.point + wall.displacement), wall.normal);
-          if (d < reach) cand[i].push_back({std::int32_t(w), 0});
+          if (d < reach) cand[i].push_back({std::int32_t(w), 0, 0.0});
         } else {
           const Mesh& mesh = s.walls.meshes[wall.mesh];
           const Vec3 q = c - wall.displacement;
@@ -402,7 +407,7 @@ void build_wall_contacts(State& s) {
                                                       mesh.vertices[tri[1]],
                                                       mesh.vertices[tri[2]], feature);
             const Vec3 d = q - cp;
-            if (dot(d, d) < reach * reach) cand[i].push_back({std::int32_t(w), t});
+            if (dot(d, d) < reach * reach) cand[i].push_back({std::int32_t(w), t, norm(d)});
           }
         }
       }
@@ -415,10 +420,11 @@ void build_wall_contacts(State& s) {
   fresh.start.assign(n + 1, 0);
   std::size_t k = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    for (auto& [w, f] : cand[i]) {
+    for (const Candidate& c : cand[i]) {
       fresh.particle[k] = std::int32_t(i);
-      fresh.wall[k] = w;
-      fresh.facet[k] = f;
+      fresh.wall[k] = c.wall;
+      fresh.facet[k] = c.facet;
+      fresh.distance[k] = c.distance;
       ++k;
     }
     fresh.start[i + 1] = std::int32_t(k);

@@ -54,12 +54,16 @@ struct WallContacts {
   std::vector<std::int32_t> particle, wall, facet;
   std::vector<double> nx, ny, nz, fsx, fsy, fsz, fn, overlap;
   std::vector<double> slip;  // slip energy of the last step (plane contacts; an output only)
+  // Mesh candidates: the distance from the particle's centre to the triangle when the list was
+  // built, which bounds it from below until the next build (kernels/walls.cpp); 0 where unknown
+  // (a list loaded or re-sorted without it), which never skips a candidate.
+  std::vector<double> distance;
   std::vector<std::int32_t> start;  // per particle offsets (CSR), particles + 1
 
   void resize(std::size_t count) {
     n = count;
     for (auto* c : {&particle, &wall, &facet}) c->resize(count);
-    for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &overlap, &slip}) c->resize(count);
+    for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &overlap, &slip, &distance}) c->resize(count);
   }
 };
 
