@@ -28,8 +28,15 @@ for k = 1, #d do
   if tau[k] >= 0.5 * level then reached = d[k]; break end
 end
 assert(reached and reached <= 0.1, ("half of the level reached at %s mm (from the start: <= 0.1 mm)"):format(tostring(reached)))
-assert(s.peak_shear_stress_mpa <= 2 * s.residual_shear_stress_mpa,
-       ("peak %.3g MPa against residual %.3g MPa"):format(s.peak_shear_stress_mpa, s.residual_shear_stress_mpa))
+-- The highest record against the level of the slide, not against the residual: the residual's
+-- 0.5 mm window is the noisy estimate the level replaces (above). On the v5 packing (2026-11-26) a
+-- stick-slip spike of 11.5 MPa at 4.3 mm stands 1.6 times over a level of 7.0 MPa, while the
+-- residual window happened to average 5.6 (S1's rigid peak is nine times its residual).
+assert(s.peak_shear_stress_mpa <= 2 * level,
+       ("peak %.3g MPa against the slide's %.3g MPa"):format(s.peak_shear_stress_mpa, level))
+assert(math.abs(s.residual_shear_stress_mpa / level - 1) <= 0.4,
+       ("residual %.3g MPa against the slide's %.3g MPa (records fluctuate by +-40 %%)"):format(
+         s.residual_shear_stress_mpa, level))
 -- The rigid model closes a joint in a few dozen of its large steps (this one in about 30): the
 -- closure is still recorded finely enough for a normal stiffness.
 assert(s.normal_stiffness_mpa_per_mm == s.normal_stiffness_mpa_per_mm and s.normal_stiffness_mpa_per_mm > 0,
