@@ -288,6 +288,15 @@ struct alignas(64) BlockRange {
   }
 };
 
+// Every block of each stage in order on the calling thread, then the finishes: run_stages on one
+// thread, and step_once's group stages where too few members move to pay for their barriers.
+void run_stages_serially(std::initializer_list<StageLoop*> stages) {
+  for (StageLoop* st : stages)
+    for (std::size_t blk = 0; blk < st->blocks; ++blk) st->run(blk);
+  for (StageLoop* st : stages)
+    if (st->finish) st->finish();
+}
+
 }  // namespace
 
 void run_stages(State& s, std::initializer_list<StageLoop*> stages) {
@@ -301,41 +310,40 @@ void run_stages(State& s, std::initializer_list<StageLoop*> stages) {
   // write their own lists only); a stage after_barrier does.
   const int threads = thread_count(s);
   if (threads == 1) {  // no parallel region (a fork costs ~1.3 us, a tenth of a rigid joint's step)
-    for (StageLoop* st : stages)
-      for (std::size_t blk = 0; blk < st->blocks; ++blk) st->run(blk);
-  } else {
-    const std::size_t count = stages.size() * std::size_t(threads);
-    static thread_local std::unique_ptr<BlockRange[]> ranges;
-    static thread_local std::size_t capacity = 0;
-    if (capacity < count) {
-      ranges = std::make_unique<BlockRange[]>(count);
-      capacity = count;
-    }
-    std::size_t si = 0;
-    for (StageLoop* st : stages) {
-      for (int t = 0; t < threads; ++t)
-        ranges[si * threads + t].set(std::uint32_t(st->blocks * t / threads),
-                                     std::uint32_t(st->blocks * (t + 1) / threads));
-      ++si;
-    }
-    BlockRange* const r = ranges.get();
+    run_stages_serially(stages);
+    return;
+  }
+  const std::size_t count = stages.size() * std::size_t(threads);
+  static thread_local std::unique_ptr<BlockRange[]> ranges;
+  static thread_local std::size_t capacity = 0;
+  if (capacity < count) {
+    ranges = std::make_unique<BlockRange[]>(count);
+    capacity = count;
+  }
+  std::size_t si = 0;
+  for (StageLoop* st : stages) {
+    for (int t = 0; t < threads; ++t)
+      ranges[si * threads + t].set(std::uint32_t(st->blocks * t / threads),
+                                   std::uint32_t(st->blocks * (t + 1) / threads));
+    ++si;
+  }
+  BlockRange* const r = ranges.get();
 #pragma omp parallel num_threads(threads)
-    {
-      // The runtime may give fewer threads than asked: the shares of the missing ones are taken
-      // by the others.
-      const int t = omp_get_thread_num();
-      std::size_t base = 0;
-      for (StageLoop* st : stages) {
-        if (st->after_barrier) {
+  {
+    // The runtime may give fewer threads than asked: the shares of the missing ones are taken
+    // by the others.
+    const int t = omp_get_thread_num();
+    std::size_t base = 0;
+    for (StageLoop* st : stages) {
+      if (st->after_barrier) {
 #pragma omp barrier
-        }
-        BlockRange* share = r + base;
-        base += std::size_t(threads);
-        std::size_t blk;
-        while (share[t].take<false>(blk)) st->run(blk);
-        for (int k = 1; k < threads; ++k)
-          while (share[(t + k) % threads].take<true>(blk)) st->run(blk);
       }
+      BlockRange* share = r + base;
+      base += std::size_t(threads);
+      std::size_t blk;
+      while (share[t].take<false>(blk)) st->run(blk);
+      for (int k = 1; k < threads; ++k)
+        while (share[(t + k) % threads].take<true>(blk)) st->run(blk);
     }
   }
   for (StageLoop* st : stages)
@@ -370,14 +378,11 @@ void step_once(State& s) {
     // barriers cost more than they save where few members move (the rigid joint's ~200: 1.15x
     // slower), so those run after the region as before (perf/README.md).
     GroupStages g = group_stages(s);
-    if (s.moved_particle.size() >= kParallelMoves || thread_count(s) == 1) {
+    if (s.moved_particle.size() >= kParallelMoves) {
       run_stages(s, {&pairs, &bonds, &walls, &particles, &g.servo, &g.motion, &g.moves});
-    } else {
+    } else {  // on one thread, the same sums in the same order as the call above
       run_stages(s, {&pairs, &bonds, &walls, &particles});
-      for (StageLoop* st : {&g.servo, &g.motion, &g.moves}) {
-        for (std::size_t blk = 0; blk < st->blocks; ++blk) st->run(blk);
-        if (st->finish) st->finish();
-      }
+      run_stages_serially({&g.servo, &g.motion, &g.moves});
     }
   }
   for (auto& w : s.walls.walls) w.displacement += w.velocity * s.dt;

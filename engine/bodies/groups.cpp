@@ -43,10 +43,10 @@ void advance_group_motion(State& s, std::size_t gi) {
   const Vec3 g = s.settings.gravity;
   const double alpha = grp.motion.damping >= 0 ? grp.motion.damping : s.settings.local_damping;
   // Idle members of a lazy group carry no force (split_idle): summing and moving the busy ones
-  // is the whole group.
-  const std::vector<std::int32_t>& moved = grp.lazy ? grp.busy : grp.members;
+  // (the group's slots of moved_particle, in member order) is the whole group.
   Vec3 F = grp.applied, T{0, 0, 0};
-  for (std::int32_t i : moved) {
+  for (std::size_t slot = s.moved_start[gi]; slot < s.moved_start[gi + 1]; ++slot) {
+    const std::int32_t i = s.moved_particle[slot];
     const Vec3 f{p.fx[i], p.fy[i], p.fz[i]};
     const Vec3 r = Vec3{p.x[i], p.y[i], p.z[i]} - grp.centre;
     F += f;
@@ -354,8 +354,7 @@ void split_idle(State& s) {
   s.moved_start.assign(s.groups.size() + 1, 0);
   for (std::size_t g = 0; g < s.groups.size(); ++g) {
     const Group& grp = s.groups[g];
-    if (!grp.members.empty())
-      for (std::int32_t i : grp.lazy ? grp.busy : grp.members) s.moved_particle.push_back(i);
+    for (std::int32_t i : grp.lazy ? grp.busy : grp.members) s.moved_particle.push_back(i);
     s.moved_start[g + 1] = s.moved_particle.size();
   }
   Incidence& bm = s.block_moved;

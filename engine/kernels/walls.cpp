@@ -176,6 +176,7 @@ StageLoop wall_stage(State& s) {
     std::vector<double> slip, work;
     std::vector<Vec3> force;
     std::vector<double> px, py, pz, nx, ny, nz, vx, vy, vz, kn, ks, friction;
+    std::vector<double> moved;  // how far each wall has moved since the neighbour build
     std::vector<std::uint8_t> plane;
   };
   auto sums = std::make_shared<Sums>();
@@ -190,6 +191,7 @@ StageLoop wall_stage(State& s) {
                     &t.friction})
       c->reserve(nw);
     t.plane.reserve(nw);
+    t.moved.reserve(nw);
     for (const Wall& w : s.walls.walls) {
       const Vec3 point = w.point + w.displacement;
       t.px.push_back(point.x); t.py.push_back(point.y); t.pz.push_back(point.z);
@@ -198,6 +200,7 @@ StageLoop wall_stage(State& s) {
       t.kn.push_back(w.material.kn); t.ks.push_back(w.material.ks);
       t.friction.push_back(w.material.friction);
       t.plane.push_back(w.kind == Wall::Kind::plane ? 1 : 0);
+      t.moved.push_back(norm(w.displacement - w.displacement_at_build));
     }
   }
   const ParticleStore& p = s.p;
@@ -246,7 +249,7 @@ StageLoop wall_stage(State& s) {
     // same zeros, and the normal it would refresh is read only to carry a zero shear force (signs
     // of zeros at most). A particle near the mould has ~40 candidates and touches one to three.
     const bool bounds = wc.distance.size() == wc.n;
-    std::int32_t moved_of = -1;
+    std::int32_t moved_of = -1;  // the particle whose displacement since the build is in `moved`
     double moved = 0;
     // The sums in contact order, and the mesh contacts.
     for (std::size_t k = first; k < end; ++k) {
@@ -267,7 +270,7 @@ StageLoop wall_stage(State& s) {
           moved = std::sqrt(dx * dx + dy * dy + dz * dz);
           moved_of = i;
         }
-        const double clearance = wc.distance[k] - moved - norm(wall.displacement - wall.displacement_at_build);
+        const double clearance = wc.distance[k] - moved - sums->moved[wc.wall[k]];
         if (clearance > p.radius[i] * (1 + 1e-9)) continue;
       }
       const Vec3 c{p.x[i], p.y[i], p.z[i]};
