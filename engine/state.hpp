@@ -88,6 +88,14 @@ struct State {
   WallStore walls;
   std::vector<Group> groups;
   BondStore bonds;
+  // Bonds held still: both ends in one rigid group that does not turn (Group::lazy). Such a bond
+  // never deforms and its forces cancel within the body, so the step leaves it out (a joint's
+  // platen layers hold a fifth of its bonds); it keeps its state, counts in the API, the energies
+  // and checkpoints, and goes back to `bonds` when its group may turn (settle_frozen_bonds).
+  // Sorted by (a, b) like `bonds`; never breaks while frozen.
+  BondStore frozen_bonds;
+  // Raised whenever the bond list changes (refresh_bond_topology): caches of bond indices check it.
+  std::uint64_t bond_version = 0;
   Incidence bond_incidence;
   // Bonded partners per particle (CSR, sorted): the neighbour search leaves bonded pairs out.
   std::vector<std::int32_t> partner_start, partners;
@@ -143,11 +151,11 @@ struct State {
   // Pairs joining two different bodies (group / group or group / free particle) of the current
   // pair list, for the servo's per-step stiffness; valid while `rebuilds` equals group_pairs_at.
   // Likewise the bonds joining two bodies (a joint's ~9000 bonds, of which a few hundred tie the
-  // platens: scanning them all every step was 3 % of its elastic step), valid while also the bond
-  // count is group_bonds_of (breaks compact the list; any other change rebuilds).
+  // platens: scanning them all every step was 3 % of its elastic step), valid while the bond list
+  // is the one of version group_bonds_of.
   std::vector<std::uint32_t> group_pairs, group_bonds;
   std::uint64_t group_pairs_at = ~std::uint64_t(0);
-  std::size_t group_bonds_of = 0;
+  std::uint64_t group_bonds_of = ~std::uint64_t(0);  // the bond_version they were taken from
 
   // Idle group members (see Group::busy), per particle index; valid while idle_valid (the split
   // is redone at every neighbour build and after the API changes motions or applied forces).
@@ -199,6 +207,11 @@ void compute_bond_forces(State& s);     // kernels/bonds.cpp
 kernels::BondKernelArgs bond_kernel_args(State& s);  // its kernel's arguments (perf/ reuses them)
 void process_breaks(State& s);          // kernels/bonds.cpp: events, energy, compaction
 void refresh_bond_topology(State& s);   // kernels/bonds.cpp: incidence, partners, rotation locks
+// kernels/bonds.cpp: moves the bonds inside lazy groups (Group::lazy, set by the caller) to
+// State::frozen_bonds and the others back; true if any moved (the topology is then refreshed).
+bool settle_frozen_bonds(State& s);
+// Every bond, active and frozen, in one store sorted by (a, b) (checkpoints).
+BondStore all_bonds(const State& s);
 // CSR of the pairs (a, b) per particle, entries (k << 1) | (particle is b), ascending k.
 void build_incidence(std::size_t particles, const std::int64_t* a, const std::int64_t* b,
                      std::size_t count, Incidence& inc);

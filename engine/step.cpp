@@ -176,9 +176,11 @@ double estimate_critical_dt(const State& s) {
     krot[b] += m.ks * lb * lb;
   }
   // Bonds [3-31, 3-32]: contact springs plus the beam, k_rot += kbn I + kbs J.
-  const BondStore& bq = s.bonds;
-  const BondMaterial& bm = bq.material;
-  for (std::size_t k = 0; k < bq.n; ++k) {
+  // Frozen bonds too (State::frozen_bonds): the estimate does not depend on which groups turn.
+  const BondMaterial& bm = s.bonds.material;
+  for (const BondStore* store : {&s.bonds, &s.frozen_bonds})
+  for (std::size_t k = 0; k < store->n; ++k) {
+    const BondStore& bq = *store;
     const auto a = bq.a[k], b = bq.b[k];
     const double kt = kc + std::max(bm.beam_kn, bm.beam_ks);
     ktran[a] += kt;
@@ -242,9 +244,10 @@ Energies compute_energies(const State& s) {
     e.strain += wc.fn[k] * wc.fn[k] / (2 * wm.kn) +
                 (wc.fsx[k] * wc.fsx[k] + wc.fsy[k] * wc.fsy[k] + wc.fsz[k] * wc.fsz[k]) / (2 * wm.ks);
   }
-  const BondStore& bq = s.bonds;
-  const BondMaterial& bm = bq.material;
-  for (std::size_t k = 0; k < bq.n; ++k) {
+  const BondMaterial& bm = s.bonds.material;
+  for (const BondStore* store : {&s.bonds, &s.frozen_bonds})  // a frozen bond keeps its energy
+  for (std::size_t k = 0; k < store->n; ++k) {
+    const BondStore& bq = *store;
     const double r2 = bq.beam_radius[k] * bq.beam_radius[k];
     e.strain += bq.fn[k] * bq.fn[k] / (2 * m.kn) +
                 (bq.fsx[k] * bq.fsx[k] + bq.fsy[k] * bq.fsy[k] + bq.fsz[k] * bq.fsz[k]) / (2 * m.ks) +

@@ -589,7 +589,7 @@ std::size_t World::install_bonds(const BondMaterial& material, double tolerance,
   require(!material.breakable || (material.tensile_strength > 0 && std::isfinite(material.tensile_strength)),
           "bond material: a breakable bond needs tensile_strength > 0 (Pa), got " +
               num(material.tensile_strength) + "; set breakable = false for unbreakable bonds");
-  if (s.bonds.n > 0) {
+  if (s.bonds.n + s.frozen_bonds.n > 0) {
     const BondMaterial& m = s.bonds.material;
     require(m.beam_kn == material.beam_kn && m.beam_ks == material.beam_ks &&
                 m.radius_factor == material.radius_factor &&
@@ -657,25 +657,30 @@ std::size_t World::install_bonds(const BondMaterial& material, double tolerance,
     ++k;
   }
   s.bonds = std::move(merged);
+  s.frozen_bonds.material = material;
+  s.frozen_bonds.any = true;
   if (stress_free && !picked.empty()) s.rest_overlaps = true;
   detail::refresh_bond_topology(s);
   touch(s);  // bonded pairs leave the contact list
   return picked.size();
 }
 
-std::size_t World::bond_count() const { return state_->bonds.n; }
+std::size_t World::bond_count() const { return state_->bonds.n + state_->frozen_bonds.n; }
 
 void World::set_bond_strength(double tensile_strength, bool breakable) {
   require(!breakable || (tensile_strength > 0 && std::isfinite(tensile_strength)),
           "set_bond_strength: a breakable bond needs tensile_strength > 0 (Pa), got " +
               num(tensile_strength));
-  state_->bonds.material.tensile_strength = breakable ? tensile_strength : 0.0;
-  state_->bonds.material.breakable = breakable;
+  for (detail::BondStore* q : {&state_->bonds, &state_->frozen_bonds}) {
+    q->material.tensile_strength = breakable ? tensile_strength : 0.0;
+    q->material.breakable = breakable;
+  }
 }
 
 void World::remove_bonds() {
   State& s = *state_;
   s.bonds.resize(0);
+  s.frozen_bonds.resize(0);
   detail::refresh_bond_topology(s);
   touch(s);  // the freed pairs enter the contact list at the next rebuild
   s.reference_energy = -1;
@@ -688,10 +693,11 @@ double World::bond_criterion(double sigma, double tau, double tensile_strength) 
 std::vector<BondInfo> World::bonds() const {
   const State& s = *state_;
   const auto& p = s.p;
-  const auto& q = s.bonds;
   std::vector<BondInfo> out;
-  out.reserve(q.n);
-  for (std::size_t k = 0; k < q.n; ++k) {
+  out.reserve(s.bonds.n + s.frozen_bonds.n);
+  for (const detail::BondStore* store : {&s.bonds, &s.frozen_bonds})
+  for (std::size_t k = 0; k < store->n; ++k) {
+    const auto& q = *store;
     BondInfo b;
     const auto ia = q.a[k], ib = q.b[k];
     b.id_a = p.id[ia];
@@ -782,6 +788,7 @@ StepStats World::stats() const {
   st.rebuilds = s.rebuilds;
   st.reorders = s.reorders;
   st.pairs = s.pairs.n;
+  st.frozen_bonds = s.frozen_bonds.n;
   st.contacts = contact_count();
   for (std::size_t k = 0; k < s.walls.contacts.n; ++k) st.wall_contacts += s.walls.contacts.overlap[k] > 0;
   st.threads = detail::thread_count(s);

@@ -251,7 +251,7 @@ void update_servo_stiffness(State& s) {
     for (Dof d : g.motion.translation) servo = servo || d == Dof::servo;
   if (!servo) return;
   const ParticleStore& p = s.p;
-  if (s.group_pairs_at != s.rebuilds || s.group_bonds_of != s.bonds.n) {
+  if (s.group_pairs_at != s.rebuilds || s.group_bonds_of != s.bond_version) {
     s.group_pairs.clear();
     for (std::size_t k = 0; k < s.pairs.n; ++k)
       if (p.group[s.pairs.a[k]] != p.group[s.pairs.b[k]]) s.group_pairs.push_back(std::uint32_t(k));
@@ -259,7 +259,7 @@ void update_servo_stiffness(State& s) {
     for (std::size_t k = 0; k < s.bonds.n; ++k)
       if (p.group[s.bonds.a[k]] != p.group[s.bonds.b[k]]) s.group_bonds.push_back(std::uint32_t(k));
     s.group_pairs_at = s.rebuilds;
-    s.group_bonds_of = s.bonds.n;
+    s.group_bonds_of = s.bond_version;
   }
   std::vector<double> K(s.groups.size(), 0.0);
   auto add = [&](std::int64_t a, std::int64_t b, double k) {
@@ -307,6 +307,9 @@ void sync_lazy(State& s) {
 
 void split_idle(State& s) {
   sync_lazy(s);
+  for (Group& g : s.groups) g.lazy = g.motion.rotation == Dof::fixed && g.angular_velocity == Vec3{};
+  // The bonds inside lazy groups leave the step first: a member held only by them is idle.
+  settle_frozen_bonds(s);
   ParticleStore& p = s.p;
   s.idle.assign(p.n, 0);
   const Incidence &inc = s.incidence, &binc = s.bond_incidence;
@@ -320,7 +323,6 @@ void split_idle(State& s) {
     g.busy.clear();
     g.idle_mass = 0;
     g.idle_base = 0;
-    g.lazy = g.motion.rotation == Dof::fixed && g.angular_velocity == Vec3{};
     if (!g.lazy) continue;
     for (std::int32_t i : g.members) {
       if (acted_on(std::size_t(i))) {

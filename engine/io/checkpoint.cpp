@@ -208,8 +208,15 @@ void visit(Io& io, State& s) {
     q->size_outputs();
   }
 
-  // Bonds.
-  auto& b = s.bonds;
+  // Bonds: one list, active and frozen together (the first step after loading freezes the same
+  // ones again: State::frozen_bonds).
+  detail::BondStore every;
+  if constexpr (std::is_same_v<Io, Writer>) {
+    if (s.frozen_bonds.n > 0) every = detail::all_bonds(s);
+  } else {
+    s.frozen_bonds.resize(0);
+  }
+  auto& b = every.n > 0 ? every : s.bonds;
   io.scalar("bonds/n", b.n);
   io.scalar("bonds/padded", b.padded);
   io.column("bonds/a", b.a);
@@ -234,6 +241,10 @@ void visit(Io& io, State& s) {
   io.scalar("bonds/material/tensile_strength", b.material.tensile_strength);
   io.flag("bonds/material/breakable", b.material.breakable);
   io.flag("bonds/any", b.any);
+  if constexpr (!std::is_same_v<Io, Writer>) {
+    s.frozen_bonds.material = b.material;
+    s.frozen_bonds.any = b.any;
+  }
 
   // Break events, as columns.
   auto& ev = s.break_events;

@@ -73,19 +73,26 @@ void refresh_bond_topology(State& s) {
   ParticleStore& p = s.p;
   BondStore& q = s.bonds;
   q.fill_padding(p.null_a(), p.null_b());
+  s.frozen_bonds.fill_padding(p.null_a(), p.null_b());
+  ++s.bond_version;
+  // The gather's incidence: the bonds the step computes. Partners and rotation locks: every bond
+  // (a frozen one still ties its particles).
   build_incidence(p.n, q.a.data(), q.b.data(), q.n, s.bond_incidence);
+  const BondStore* stores[2] = {&s.bonds, &s.frozen_bonds};
   s.partner_start.assign(p.n + 1, 0);
-  for (std::size_t k = 0; k < q.n; ++k) {
-    ++s.partner_start[q.a[k] + 1];
-    ++s.partner_start[q.b[k] + 1];
-  }
+  for (const BondStore* st : stores)
+    for (std::size_t k = 0; k < st->n; ++k) {
+      ++s.partner_start[st->a[k] + 1];
+      ++s.partner_start[st->b[k] + 1];
+    }
   for (std::size_t i = 0; i < p.n; ++i) s.partner_start[i + 1] += s.partner_start[i];
-  s.partners.resize(2 * q.n);
+  s.partners.resize(std::size_t(s.partner_start[p.n]));
   std::vector<std::int32_t> fill(s.partner_start.begin(), s.partner_start.end() - 1);
-  for (std::size_t k = 0; k < q.n; ++k) {
-    s.partners[fill[q.a[k]]++] = std::int32_t(q.b[k]);
-    s.partners[fill[q.b[k]]++] = std::int32_t(q.a[k]);
-  }
+  for (const BondStore* st : stores)
+    for (std::size_t k = 0; k < st->n; ++k) {
+      s.partners[fill[st->a[k]]++] = std::int32_t(st->b[k]);
+      s.partners[fill[st->b[k]]++] = std::int32_t(st->a[k]);
+    }
   for (std::size_t i = 0; i < p.n; ++i)
     std::sort(s.partners.begin() + s.partner_start[i], s.partners.begin() + s.partner_start[i + 1]);
   s.bonded_particles.clear();
@@ -106,6 +113,72 @@ void refresh_bond_topology(State& s) {
     p.rotation_locked[i] = locked ? 1 : 0;
     s.any_rotating = s.any_rotating || !locked;
   }
+}
+
+namespace {
+// x and y (each sorted by (a, b), no bond in both) into one store sorted by (a, b).
+BondStore merge_bonds(const BondStore& x, const BondStore& y) {
+  BondStore out;
+  out.material = x.n > 0 ? x.material : y.material;
+  out.any = x.any || y.any;
+  out.resize(x.n + y.n);
+  std::size_t i = 0, j = 0;
+  for (std::size_t k = 0; k < out.n; ++k) {
+    const bool from_x = j >= y.n || (i < x.n && (x.a[i] != y.a[j] ? x.a[i] < y.a[j] : x.b[i] < y.b[j]));
+    if (from_x) out.copy_from(x, i++, k);
+    else out.copy_from(y, j++, k);
+  }
+  return out;
+}
+}  // namespace
+
+BondStore all_bonds(const State& s) {
+  BondStore all = merge_bonds(s.bonds, s.frozen_bonds);
+  all.material = s.bonds.material;
+  all.any = s.bonds.any;
+  return all;
+}
+
+bool settle_frozen_bonds(State& s) {
+  const ParticleStore& p = s.p;
+  auto frozen_here = [&](std::int64_t a, std::int64_t b) {
+    const std::int32_t g = p.group[std::size_t(a)];
+    return g >= 0 && g == p.group[std::size_t(b)] && s.groups[std::size_t(g)].lazy;
+  };
+  std::size_t to_freeze = 0, to_thaw = 0;
+  for (std::size_t k = 0; k < s.bonds.n; ++k) to_freeze += frozen_here(s.bonds.a[k], s.bonds.b[k]);
+  for (std::size_t k = 0; k < s.frozen_bonds.n; ++k)
+    to_thaw += !frozen_here(s.frozen_bonds.a[k], s.frozen_bonds.b[k]);
+  if (to_freeze == 0 && to_thaw == 0) return false;
+  // Split each store into the bonds that stay and the ones that move, then merge: both stores stay
+  // sorted by (a, b), so the partition is the same whatever the history (checkpoints hold one list).
+  BondStore stores[2][2];  // [from active, from frozen][stays active, goes frozen]
+  const BondStore* from[2] = {&s.bonds, &s.frozen_bonds};
+  for (int f = 0; f < 2; ++f) {
+    const BondStore& q = *from[f];
+    std::size_t count[2] = {0, 0};
+    for (std::size_t k = 0; k < q.n; ++k) ++count[frozen_here(q.a[k], q.b[k])];
+    for (int t = 0; t < 2; ++t) {
+      stores[f][t].material = s.bonds.material;
+      stores[f][t].any = s.bonds.any;
+      stores[f][t].resize(count[t]);
+    }
+    std::size_t at[2] = {0, 0};
+    for (std::size_t k = 0; k < q.n; ++k) {
+      const int t = frozen_here(q.a[k], q.b[k]);
+      stores[f][t].copy_from(q, k, at[t]++);
+    }
+  }
+  const BondMaterial material = s.bonds.material;
+  const bool any = s.bonds.any;
+  s.bonds = merge_bonds(stores[0][0], stores[1][0]);
+  s.frozen_bonds = merge_bonds(stores[0][1], stores[1][1]);
+  for (BondStore* q : {&s.bonds, &s.frozen_bonds}) {
+    q->material = material;
+    q->any = any;
+  }
+  refresh_bond_topology(s);
+  return true;
 }
 
 StageLoop bond_stage(State& s) {

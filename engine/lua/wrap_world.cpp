@@ -1066,7 +1066,7 @@ int world_simd(lua_State* L) {
 int world_stats(lua_State* L) {
   return guarded(L, [&] {
     StepStats s = world_arg(L).stats();
-    lua_createtable(L, 0, 7);
+    lua_createtable(L, 0, 8);
     auto put = [&](const char* k, std::uint64_t v) {
       lua_pushinteger(L, static_cast<lua_Integer>(v));
       lua_setfield(L, -2, k);
@@ -1076,6 +1076,7 @@ int world_stats(lua_State* L) {
     put("pairs", s.pairs);
     put("contacts", s.contacts);
     put("wall_contacts", s.wall_contacts);
+    put("frozen_bonds", s.frozen_bonds);
     put("threads", std::uint64_t(s.threads));
     if (s.busy_elsewhere >= 0) {  // nil where not measured
       lua_pushnumber(L, s.busy_elsewhere);
@@ -1318,7 +1319,7 @@ void open_world(lua_State* L) {
       {"time", world_time, "world:time() -> s", "Simulated time."},
       {"set_threads", world_set_threads, "world:set_threads(n)", "OpenMP threads (0: automatic, by the number of pairs and bonds, up to the cores that other processes leave free)."},
       {"simd", world_simd, "world:simd() -> name", "SIMD architecture of the kernels."},
-      {"stats", world_stats, "world:stats() -> table", "Rebuilds, reorders, pairs, contacts, wall_contacts; threads (of the next step) and, with automatic threads, busy_elsewhere (cores other processes kept busy lately, which the count leaves to them)."},
+      {"stats", world_stats, "world:stats() -> table", "Rebuilds, reorders, pairs, contacts, wall_contacts, frozen_bonds (bonds inside a rigid group that does not turn, which the step leaves out); threads (of the next step) and, with automatic threads, busy_elsewhere (cores other processes kept busy lately, which the count leaves to them)."},
       {"rebuild_neighbors", world_rebuild_neighbors, "world:rebuild_neighbors()", "Rebuilds the pair list now."},
       // measurements
       {"energies", world_energies, "world:energies() -> table",

@@ -217,8 +217,9 @@ void reorder(State& s, const CellGrid& g) {
   }
   w = std::move(ws);
 
-  // Bonds: the same renumbering; the history flips with the roles.
-  BondStore& bq = s.bonds;
+  // Bonds, active and frozen: the same renumbering; the history flips with the roles.
+  for (BondStore* store : {&s.bonds, &s.frozen_bonds}) {
+  BondStore& bq = *store;
   for (std::size_t k = 0; k < bq.n; ++k) {
     std::int64_t a = new_index[bq.a[k]], b = new_index[bq.b[k]];
     if (a > b) {
@@ -241,6 +242,7 @@ void reorder(State& s, const CellGrid& g) {
   bs.resize(bq.n);
   for (std::size_t k = 0; k < bq.n; ++k) bs.copy_from(bq, bp[k], k);
   bq = std::move(bs);
+  }
   // Inherited contacts of broken bonds: renumber (sorted when merged).
   PairStore& ih = s.inherited;
   for (std::size_t k = 0; k < ih.n; ++k) {

@@ -157,6 +157,9 @@ struct StepStats {
   std::size_t pairs = 0;       // pairs in the neighbour list (touching or not)
   std::size_t contacts = 0;    // touching ball-ball pairs
   std::size_t wall_contacts = 0;
+  // Bonds inside a rigid group that does not turn: they cannot deform and their forces cancel
+  // within the body, so the step leaves them out (they still count in bond_count and bonds()).
+  std::size_t frozen_bonds = 0;
   int threads = 1;                 // threads the next step runs on
   double busy_elsewhere = -1;      // cores other processes kept busy lately (automatic threads
                                    // only; -1: not measured), which the automatic count leaves

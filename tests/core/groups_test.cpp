@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <string>
 #include <random>
@@ -264,4 +265,100 @@ TEST(Groups, BadInputIsRefusedWithAReason) {
   EXPECT_THROW(w.add_group(std::vector<std::int64_t>{42}), Error);
   EXPECT_THROW(w.group_force(3), Error);
   EXPECT_THROW(w.set_velocity(a, {1, 0, 0}), Error) << "members move with their group";
+}
+
+namespace {
+// A small bonded joint: two platens (rigid groups of 4 x 4 spheres) and two free layers between,
+// every touching pair bonded. The upper platen shears along x under a servo-held normal force.
+struct BondedSandwich {
+  World w;
+  std::vector<std::int64_t> bottom, top, free;
+  int g_bottom = -1, g_top = -1;
+};
+
+BondedSandwich bonded_sandwich(bool bonds_before_groups, Dof top_rotation = Dof::fixed) {
+  const double R = 5e-4, h = 1.9 * R;  // neighbours overlap by 0.1 R
+  WorldSettings ws;
+  ws.dt = 2e-4;
+  BondedSandwich s{World(ws), {}, {}, {}};
+  for (int layer = 0; layer < 4; ++layer)
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) {
+        const auto id = s.w.add_particle({i * h, j * h, layer * h}, R);
+        (layer == 0 ? s.bottom : layer == 3 ? s.top : s.free).push_back(id);
+      }
+  BondMaterial bm;
+  bm.breakable = false;
+  GroupMotion fixed{{Dof::fixed, Dof::fixed, Dof::fixed}};
+  // The upper platen's load is servo-held: its motion follows the sum of its members' forces.
+  GroupMotion shear{{Dof::velocity, Dof::fixed, Dof::servo}, {2e-4, 0, 0}};
+  shear.servo[2].target_force = 2e-5;
+  shear.rotation = top_rotation;
+  if (bonds_before_groups) s.w.install_bonds(bm);
+  s.g_bottom = s.w.add_group(s.bottom, fixed);
+  s.g_top = s.w.add_group(s.top, shear);
+  if (!bonds_before_groups) s.w.install_bonds(bm);  // members of one group are never paired
+  return s;
+}
+}  // namespace
+
+// A bond with both ends in one rigid group that does not turn cannot deform, and its forces cancel
+// within the body: the step leaves it out (State::frozen_bonds). The same joint bonded before the
+// groups were made (platens bonded inside) and after (no bond inside a platen) must then move
+// bit for bit alike, while the first still reports every bond.
+TEST(Groups, BondsInsideAStillGroupLeaveTheStepAndChangeNothing) {
+  BondedSandwich inside = bonded_sandwich(true), without = bonded_sandwich(false);
+  const std::size_t per_platen = 2 * 4 * 3;  // a 4 x 4 square's touching neighbours
+  ASSERT_EQ(inside.w.bond_count(), without.w.bond_count() + 2 * per_platen);
+  const std::vector<BondInfo> before = inside.w.bonds();
+  inside.w.cycle(400);
+  without.w.cycle(400);
+  EXPECT_EQ(inside.w.stats().frozen_bonds, 2 * per_platen);
+  EXPECT_EQ(without.w.stats().frozen_bonds, 0u);
+  EXPECT_EQ(inside.w.bond_count(), without.w.bond_count() + 2 * per_platen);
+  const auto xi = inside.w.positions(), xw = without.w.positions();
+  ASSERT_EQ(xi.size(), xw.size());
+  for (std::size_t k = 0; k < xi.size(); ++k) ASSERT_EQ(xi[k], xw[k]) << "coordinate " << k;
+  EXPECT_EQ(inside.w.group_force(inside.g_top), without.w.group_force(without.g_top));
+  EXPECT_GT(std::abs(without.w.group_force(without.g_top).x), 0.0) << "the free layers resist";
+  EXPECT_NE(inside.w.group_position(inside.g_top).z, 3 * 1.9 * 5e-4) << "the servo moved the platen";
+  // A frozen bond keeps the state it had: a platen's inner bond reads as installed.
+  const std::vector<BondInfo> after = inside.w.bonds();
+  ASSERT_EQ(after.size(), before.size());
+  std::size_t platen_bonds = 0;
+  for (std::size_t k = 0; k < after.size(); ++k) {
+    const int ga = inside.w.group_of(after[k].id_a), gb = inside.w.group_of(after[k].id_b);
+    if (ga < 0 || ga != gb) continue;
+    ++platen_bonds;
+    EXPECT_EQ(after[k].normal_force, before[k].normal_force);
+    EXPECT_EQ(after[k].shear_force, before[k].shear_force);
+  }
+  EXPECT_EQ(platen_bonds, 2 * per_platen);
+}
+
+// A group that may turn computes its inner bonds again (their forces turn with it); a checkpoint
+// holds frozen and computed bonds in one list and the loaded run freezes the same ones.
+TEST(Groups, FrozenBondsThawWhenTheGroupMayTurnAndSurviveACheckpoint) {
+  BondedSandwich s = bonded_sandwich(true);
+  s.w.cycle(100);
+  ASSERT_EQ(s.w.stats().frozen_bonds, 48u);
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "asperity_frozen_bonds_test.h5").string();
+  s.w.save(path);
+  World r = World::load(path, 1, s.w.simd_architecture());
+  std::filesystem::remove(path);
+  EXPECT_EQ(r.bond_count(), s.w.bond_count());
+  s.w.cycle(200);
+  r.cycle(200);
+  EXPECT_EQ(r.stats().frozen_bonds, 48u);
+  EXPECT_EQ(r.positions(), s.w.positions());
+
+  GroupMotion turning = s.w.group_motion(s.g_top);
+  turning.rotation = Dof::free;
+  s.w.set_group_motion(s.g_top, turning);
+  s.w.cycle(1);
+  EXPECT_EQ(s.w.stats().frozen_bonds, 24u) << "the bottom platen's stay frozen";
+  s.w.cycle(200);
+  EXPECT_EQ(s.w.bond_count(), r.bond_count());
+  for (double x : s.w.positions()) ASSERT_TRUE(std::isfinite(x));
 }
