@@ -99,8 +99,8 @@ struct State {
   Incidence bond_incidence;
   // Bonded partners per particle (CSR, sorted): the neighbour search leaves bonded pairs out.
   std::vector<std::int32_t> partner_start, partners;
-  // The particles holding a bond (refresh_bond_topology): the bond stage checks their angular
-  // velocities each step (kernels/bonds.cpp, bond_stage).
+  // The particles holding a bond the step computes (frozen ones aside; refresh_bond_topology):
+  // the bond stage checks their angular velocities each step (kernels/bonds.cpp, bond_stage).
   std::vector<std::int32_t> bonded_particles;
   // Contacts that a broken bond leaves behind (overlapping pairs with their capped shear force):
   // merged into the pair list at the next rebuild, which a break always triggers.

@@ -95,9 +95,9 @@ void refresh_bond_topology(State& s) {
     }
   for (std::size_t i = 0; i < p.n; ++i)
     std::sort(s.partners.begin() + s.partner_start[i], s.partners.begin() + s.partner_start[i + 1]);
-  s.bonded_particles.clear();
+  s.bonded_particles.clear();  // what the bond stage reads: the ends of the bonds it computes
   for (std::size_t i = 0; i < p.n; ++i)
-    if (s.partner_start[i + 1] > s.partner_start[i]) s.bonded_particles.push_back(std::int32_t(i));
+    if (s.bond_incidence.start[i + 1] > s.bond_incidence.start[i]) s.bonded_particles.push_back(std::int32_t(i));
   // Beam moments: new bonds start without one, and a checkpoint or a break may bring back some.
   s.bond_moments_zero = true;
   for (std::size_t k = 0; k < q.n && s.bond_moments_zero; ++k)
