@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "lattice_scene.hpp"
+#include "state.hpp"
 
 namespace {
 struct Run {
@@ -23,10 +24,19 @@ extern "C" {
 // ASPERITY_AB_BONDED=1 in the environment: every touching pair bonded, unbreakable, as
 // `perf/lattice.lua bonded=true` (the bond kernel's scene), with the automatic time step.
 // ASPERITY_AB_WORLD=FILE: instead of the lattice, the world of a checkpoint (say the joint in
-// mid-shear, `scripts/joint.lua shear=0.1 save=FILE`), which continues as the saved run would.
+// mid-shear, `scripts/joint.lua shear=0.1 save=FILE`), which continues as the saved run would;
+// with ASPERITY_AB_REORDER=1 renumbered first by the module's own reorder.
 __attribute__((visibility("default"))) void* asperity_ab_make(int n, int threads) {
-  if (const char* file = std::getenv("ASPERITY_AB_WORLD"); file && *file)
-    return new Run{asperity::World::load(file, threads)};
+  if (const char* file = std::getenv("ASPERITY_AB_WORLD"); file && *file) {
+    auto* run = new Run{asperity::World::load(file, threads)};
+    // ASPERITY_AB_REORDER=1: renumber the loaded world now, as each module's build would order it
+    // (a saved world keeps the order of the build that saved it).
+    if (const char* r = std::getenv("ASPERITY_AB_REORDER"); r && std::strcmp(r, "1") == 0) {
+      run->world.state().force_reorder = true;
+      run->world.rebuild_neighbors();
+    }
+    return run;
+  }
   asperity::perf::LatticeOptions o;
   o.n = n;
   o.threads = threads;

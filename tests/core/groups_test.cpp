@@ -294,6 +294,9 @@ BondedSandwich bonded_sandwich(bool bonds_before_groups, Dof top_rotation = Dof:
   GroupMotion shear{{Dof::velocity, Dof::fixed, Dof::servo}, {2e-4, 0, 0}};
   shear.servo[2].target_force = 2e-5;
   shear.rotation = top_rotation;
+  // The first build renumbers the particles: made here, before the groups, in both variants, so
+  // that both number them alike (members come after free particles once groups exist).
+  s.w.rebuild_neighbors();
   if (bonds_before_groups) s.w.install_bonds(bm);
   s.g_bottom = s.w.add_group(s.bottom, fixed);
   s.g_top = s.w.add_group(s.top, shear);

@@ -131,3 +131,43 @@ TEST(History, LargeScenesAreOrderedByTheRasterOfTheirCells) {
   EXPECT_EQ(site_of(small.state().p, 0), (std::array<long, 3>{0, 0, 0}));
   EXPECT_EQ(site_of(small.state().p, 1), (std::array<long, 3>{0, 0, 1}));  // then +x
 }
+
+// With rigid groups the reorder puts free particles first, then members, then inert members, each
+// class along the curve: blocks of members hold no free particle to integrate.
+TEST(History, TheReorderPutsFreeParticlesBeforeGroupMembersAndInertOnesLast) {
+  WorldSettings ws;
+  ws.dt = 1e-4;
+  World w(ws);
+  std::vector<double> xyz, radii;
+  std::vector<std::int64_t> top, deep;
+  std::mt19937 rng(3);
+  std::vector<std::array<int, 3>> sites;
+  for (int z = 0; z < 8; ++z)
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 8; ++x) sites.push_back({x, y, z});
+  std::shuffle(sites.begin(), sites.end(), rng);
+  for (const auto& s : sites) {
+    for (int d = 0; d < 3; ++d) xyz.push_back((s[d] + 0.5) * kSpacing);
+    radii.push_back(0.45 * kSpacing);
+  }
+  const std::int64_t first = w.add_particles(xyz, radii, 2500.0);
+  for (std::int64_t id = first; id < first + std::int64_t(sites.size()); ++id) {
+    const auto& s = sites[std::size_t(id - first)];
+    if (s[2] >= 6) top.push_back(id);               // the two top layers: a platen
+    if (s[2] == 7 && s[0] < 4) deep.push_back(id);  // half of its top layer inert
+  }
+  w.add_group(top, GroupMotion{{Dof::fixed, Dof::fixed, Dof::fixed}});
+  w.set_inert(deep);
+  w.cycle(1);  // the first neighbour build reorders
+  ASSERT_GE(w.stats().reorders, 1u);
+  const auto& p = w.state().p;
+  auto klass = [&](std::size_t i) { return p.inert[i] ? 2 : p.group[i] >= 0 ? 1 : 0; };
+  std::size_t counts[3] = {0, 0, 0};
+  for (std::size_t i = 0; i < p.n; ++i) {
+    ++counts[klass(i)];
+    if (i > 0) ASSERT_LE(klass(i - 1), klass(i)) << "index " << i;
+  }
+  EXPECT_EQ(counts[0], 384u);
+  EXPECT_EQ(counts[1], 128u - 32u);
+  EXPECT_EQ(counts[2], 32u);
+}
