@@ -63,6 +63,17 @@ struct Ledger {
 // combined in block order, so sums do not depend on how blocks are spread over threads.
 inline constexpr std::size_t kPairBlock = 1024;      // multiple of kMaxLanes
 inline constexpr std::size_t kParticleBlock = 512;
+// The pair and bond stages' block for a list of `total` entries: kPairBlock, or smaller (down to
+// 256) so that a short list still makes 32 blocks. Two threads even out their shares by taking
+// each other's last blocks (step.cpp, run_stages); the joint's ~7000 bonds in 7 blocks of 1024
+// left one thread waiting for the other's last block (blocks of 256: 0.956 of its two-thread
+// step; the lattice of 187 000 pairs is slower with 256, so long lists keep 1024). A function of
+// the list alone, never of the thread count: the blocks' partial sums are combined in order.
+inline std::size_t pair_block_size(std::size_t total) {
+  constexpr std::size_t stage = PairStore::kTouchStage;  // blocks of whole pair stages
+  const std::size_t want = (total / 32 + stage - 1) / stage * stage;
+  return std::min(kPairBlock, std::max(std::size_t(256), want));
+}
 
 // A per-pair or per-bond record array this large is taken to be past the caches: the pair kernel
 // writes it with non-temporal stores (kernels/pairs.cpp) and the gather prefetches it

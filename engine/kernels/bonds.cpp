@@ -210,12 +210,13 @@ StageLoop bond_stage(State& s) {
   if (spin) s.bond_moments_zero = false;
   s.bond_records_with_moments = kernel != s.kernels->bond_no_moment;
   const std::size_t total = s.bonds.padded;
-  st.blocks = (total + kPairBlock - 1) / kPairBlock;
+  const std::size_t block = pair_block_size(total);
+  st.blocks = (total + block - 1) / block;
   s.bond_block_breaks.assign(st.blocks, 0.0);
   double* breaks = s.bond_block_breaks.data();
   st.run = [=](std::size_t blk) {
-    const std::size_t begin = blk * kPairBlock;
-    breaks[blk] = kernel(args, begin, std::min(total, begin + kPairBlock));
+    const std::size_t begin = blk * block;
+    breaks[blk] = kernel(args, begin, std::min(total, begin + block));
   };
   return st;  // no finish: the breaks are processed after the step (process_breaks)
 }

@@ -68,12 +68,13 @@ StageLoop pair_stage(State& s) {
   const std::size_t total = s.pairs.padded;
   s.pairs.outputs_in_records = true;  // the kernel writes fn and U to the records only
   StageLoop st;
-  st.blocks = (total + kPairBlock - 1) / kPairBlock;
+  const std::size_t block = pair_block_size(total);
+  st.blocks = (total + block - 1) / block;
   s.pair_block_slip.assign(st.blocks, 0.0);
   double* slip = s.pair_block_slip.data();
   st.run = [=](std::size_t blk) {
-    const std::size_t begin = blk * kPairBlock;
-    slip[blk] = kernel(args, begin, std::min(total, begin + kPairBlock));
+    const std::size_t begin = blk * block;
+    slip[blk] = kernel(args, begin, std::min(total, begin + block));
 #if defined(__SSE2__)
     if (args.stream) _mm_sfence();  // the streamed records are visible to every thread after it
 #endif
