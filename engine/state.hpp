@@ -211,6 +211,13 @@ StageLoop bond_stage(State& s);         // kernels/bonds.cpp
 StageLoop wall_stage(State& s);         // kernels/walls.cpp
 StageLoop integrate_stage(State& s);    // kernels/integrate.cpp: gather + integrate
 void run_stages(State& s, std::initializer_list<StageLoop*> stages);  // step.cpp
+// f(store, k) for every bond: the ones the step computes (s.bonds), then the frozen ones.
+template <class F>
+void for_each_bond(const State& s, F&& f) {
+  for (const BondStore* q : {&s.bonds, &s.frozen_bonds})
+    for (std::size_t k = 0; k < q->n; ++k) f(*q, k);
+}
+
 void compute_pair_forces(State& s);     // kernels/pairs.cpp
 kernels::PairKernelArgs pair_kernel_args(State& s);  // its kernel's arguments (perf/ reuses them)
 void compute_wall_forces(State& s);     // kernels/walls.cpp

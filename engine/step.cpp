@@ -178,9 +178,7 @@ double estimate_critical_dt(const State& s) {
   // Bonds [3-31, 3-32]: contact springs plus the beam, k_rot += kbn I + kbs J.
   // Frozen bonds too (State::frozen_bonds): the estimate does not depend on which groups turn.
   const BondMaterial& bm = s.bonds.material;
-  for (const BondStore* store : {&s.bonds, &s.frozen_bonds})
-  for (std::size_t k = 0; k < store->n; ++k) {
-    const BondStore& bq = *store;
+  for_each_bond(s, [&](const BondStore& bq, std::size_t k) {
     const auto a = bq.a[k], b = bq.b[k];
     const double kt = kc + std::max(bm.beam_kn, bm.beam_ks);
     ktran[a] += kt;
@@ -191,7 +189,7 @@ double estimate_critical_dt(const State& s) {
     const double la = p.radius[a] - 0.5 * U, lb = p.radius[b] - 0.5 * U;
     krot[a] += (m.ks + bm.beam_ks) * la * la + beam_rot;
     krot[b] += (m.ks + bm.beam_ks) * lb * lb + beam_rot;
-  }
+  });
   const WallContacts& wc = s.walls.contacts;
   for (std::size_t k = 0; k < wc.n; ++k) {
     const double U = wc.overlap[k];
@@ -245,9 +243,7 @@ Energies compute_energies(const State& s) {
                 (wc.fsx[k] * wc.fsx[k] + wc.fsy[k] * wc.fsy[k] + wc.fsz[k] * wc.fsz[k]) / (2 * wm.ks);
   }
   const BondMaterial& bm = s.bonds.material;
-  for (const BondStore* store : {&s.bonds, &s.frozen_bonds})  // a frozen bond keeps its energy
-  for (std::size_t k = 0; k < store->n; ++k) {
-    const BondStore& bq = *store;
+  for_each_bond(s, [&](const BondStore& bq, std::size_t k) {  // a frozen bond keeps its energy
     const double r2 = bq.beam_radius[k] * bq.beam_radius[k];
     e.strain += bq.fn[k] * bq.fn[k] / (2 * m.kn) +
                 (bq.fsx[k] * bq.fsx[k] + bq.fsy[k] * bq.fsy[k] + bq.fsz[k] * bq.fsz[k]) / (2 * m.ks) +
@@ -256,7 +252,7 @@ Energies compute_energies(const State& s) {
                 bq.mbn[k] * bq.mbn[k] / (2 * bm.beam_ks * 0.5 * r2) +
                 (bq.mbsx[k] * bq.mbsx[k] + bq.mbsy[k] * bq.mbsy[k] + bq.mbsz[k] * bq.mbsz[k]) /
                     (2 * bm.beam_kn * 0.25 * r2);
-  }
+  });
   e.released = s.ledger.released;
   e.friction = s.ledger.friction;
   e.damping = s.ledger.damping;

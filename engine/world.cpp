@@ -695,9 +695,7 @@ std::vector<BondInfo> World::bonds() const {
   const auto& p = s.p;
   std::vector<BondInfo> out;
   out.reserve(s.bonds.n + s.frozen_bonds.n);
-  for (const detail::BondStore* store : {&s.bonds, &s.frozen_bonds})
-  for (std::size_t k = 0; k < store->n; ++k) {
-    const auto& q = *store;
+  detail::for_each_bond(s, [&](const detail::BondStore& q, std::size_t k) {
     BondInfo b;
     const auto ia = q.a[k], ib = q.b[k];
     b.id_a = p.id[ia];
@@ -722,7 +720,7 @@ std::vector<BondInfo> World::bonds() const {
       b.bending_moment = -b.bending_moment;
     }
     out.push_back(b);
-  }
+  });
   std::sort(out.begin(), out.end(), [](const BondInfo& u, const BondInfo& v) {
     return u.id_a != v.id_a ? u.id_a < v.id_a : u.id_b < v.id_b;
   });

@@ -78,21 +78,18 @@ void refresh_bond_topology(State& s) {
   // The gather's incidence: the bonds the step computes. Partners and rotation locks: every bond
   // (a frozen one still ties its particles).
   build_incidence(p.n, q.a.data(), q.b.data(), q.n, s.bond_incidence);
-  const BondStore* stores[2] = {&s.bonds, &s.frozen_bonds};
   s.partner_start.assign(p.n + 1, 0);
-  for (const BondStore* st : stores)
-    for (std::size_t k = 0; k < st->n; ++k) {
-      ++s.partner_start[st->a[k] + 1];
-      ++s.partner_start[st->b[k] + 1];
-    }
+  for_each_bond(s, [&](const BondStore& b, std::size_t k) {
+    ++s.partner_start[b.a[k] + 1];
+    ++s.partner_start[b.b[k] + 1];
+  });
   for (std::size_t i = 0; i < p.n; ++i) s.partner_start[i + 1] += s.partner_start[i];
   s.partners.resize(std::size_t(s.partner_start[p.n]));
   std::vector<std::int32_t> fill(s.partner_start.begin(), s.partner_start.end() - 1);
-  for (const BondStore* st : stores)
-    for (std::size_t k = 0; k < st->n; ++k) {
-      s.partners[fill[st->a[k]]++] = std::int32_t(st->b[k]);
-      s.partners[fill[st->b[k]]++] = std::int32_t(st->a[k]);
-    }
+  for_each_bond(s, [&](const BondStore& b, std::size_t k) {
+    s.partners[fill[b.a[k]]++] = std::int32_t(b.b[k]);
+    s.partners[fill[b.b[k]]++] = std::int32_t(b.a[k]);
+  });
   for (std::size_t i = 0; i < p.n; ++i)
     std::sort(s.partners.begin() + s.partner_start[i], s.partners.begin() + s.partner_start[i + 1]);
   s.bonded_particles.clear();  // what the bond stage reads: the ends of the bonds it computes
@@ -117,10 +114,9 @@ void refresh_bond_topology(State& s) {
 
 namespace {
 // x and y (each sorted by (a, b), no bond in both) into one store sorted by (a, b).
+// The material is the world's one (s.bonds.material), set by the caller.
 BondStore merge_bonds(const BondStore& x, const BondStore& y) {
   BondStore out;
-  out.material = x.n > 0 ? x.material : y.material;
-  out.any = x.any || y.any;
   out.resize(x.n + y.n);
   std::size_t i = 0, j = 0;
   for (std::size_t k = 0; k < out.n; ++k) {
@@ -158,11 +154,7 @@ bool settle_frozen_bonds(State& s) {
     const BondStore& q = *from[f];
     std::size_t count[2] = {0, 0};
     for (std::size_t k = 0; k < q.n; ++k) ++count[frozen_here(q.a[k], q.b[k])];
-    for (int t = 0; t < 2; ++t) {
-      stores[f][t].material = s.bonds.material;
-      stores[f][t].any = s.bonds.any;
-      stores[f][t].resize(count[t]);
-    }
+    for (int t = 0; t < 2; ++t) stores[f][t].resize(count[t]);
     std::size_t at[2] = {0, 0};
     for (std::size_t k = 0; k < q.n; ++k) {
       const int t = frozen_here(q.a[k], q.b[k]);

@@ -147,6 +147,33 @@ std::array<int, 3> raster_axes(const CellGrid& g) {
   return axis;
 }
 
+// A bond list renumbered by a reorder and sorted by (a, b) again; the history flips with the
+// roles where a and b swap.
+void renumber_bonds(BondStore& bq, const std::vector<std::int64_t>& new_index) {
+  for (std::size_t k = 0; k < bq.n; ++k) {
+    std::int64_t a = new_index[bq.a[k]], b = new_index[bq.b[k]];
+    if (a > b) {
+      std::swap(a, b);
+      for (auto* c : {&bq.nx, &bq.ny, &bq.nz, &bq.fsx, &bq.fsy, &bq.fsz, &bq.fbsx, &bq.fbsy,
+                      &bq.fbsz, &bq.mbn, &bq.mbsx, &bq.mbsy, &bq.mbsz})
+        (*c)[k] = -(*c)[k];
+    }
+    bq.a[k] = a;
+    bq.b[k] = b;
+  }
+  std::vector<std::size_t> bp(bq.n);
+  std::iota(bp.begin(), bp.end(), 0);
+  std::sort(bp.begin(), bp.end(), [&](std::size_t u, std::size_t v) {
+    return bq.a[u] != bq.a[v] ? bq.a[u] < bq.a[v] : bq.b[u] < bq.b[v];
+  });
+  BondStore bs;
+  bs.material = bq.material;
+  bs.any = bq.any;
+  bs.resize(bq.n);
+  for (std::size_t k = 0; k < bq.n; ++k) bs.copy_from(bq, bp[k], k);
+  bq = std::move(bs);
+}
+
 // Renumber particles along the Morton curve of their cells, or in their raster order in large
 // scenes (design notes), stable within a cell, and every index that refers to them.
 void reorder(State& s, const CellGrid& g) {
@@ -229,31 +256,8 @@ void reorder(State& s, const CellGrid& g) {
   w = std::move(ws);
 
   // Bonds, active and frozen: the same renumbering; the history flips with the roles.
-  for (BondStore* store : {&s.bonds, &s.frozen_bonds}) {
-  BondStore& bq = *store;
-  for (std::size_t k = 0; k < bq.n; ++k) {
-    std::int64_t a = new_index[bq.a[k]], b = new_index[bq.b[k]];
-    if (a > b) {
-      std::swap(a, b);
-      for (auto* c : {&bq.nx, &bq.ny, &bq.nz, &bq.fsx, &bq.fsy, &bq.fsz, &bq.fbsx, &bq.fbsy,
-                      &bq.fbsz, &bq.mbn, &bq.mbsx, &bq.mbsy, &bq.mbsz})
-        (*c)[k] = -(*c)[k];
-    }
-    bq.a[k] = a;
-    bq.b[k] = b;
-  }
-  std::vector<std::size_t> bp(bq.n);
-  std::iota(bp.begin(), bp.end(), 0);
-  std::sort(bp.begin(), bp.end(), [&](std::size_t u, std::size_t v) {
-    return bq.a[u] != bq.a[v] ? bq.a[u] < bq.a[v] : bq.b[u] < bq.b[v];
-  });
-  BondStore bs;
-  bs.material = bq.material;
-  bs.any = bq.any;
-  bs.resize(bq.n);
-  for (std::size_t k = 0; k < bq.n; ++k) bs.copy_from(bq, bp[k], k);
-  bq = std::move(bs);
-  }
+  renumber_bonds(s.bonds, new_index);
+  renumber_bonds(s.frozen_bonds, new_index);
   // Inherited contacts of broken bonds: renumber (sorted when merged).
   PairStore& ih = s.inherited;
   for (std::size_t k = 0; k < ih.n; ++k) {
