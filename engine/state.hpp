@@ -234,6 +234,9 @@ BondStore all_bonds(const State& s);
 void build_incidence(std::size_t particles, const std::int64_t* a, const std::int64_t* b,
                      std::size_t count, Incidence& inc);
 void gather_and_integrate(State& s);    // kernels/integrate.cpp
+// neighbor/build.cpp: pairs the list lacks (sorted by (a, b), with their history) merged into it
+// between two rebuilds; the incidence is rebuilt and the group split redone at the next step.
+void insert_pairs(State& s, const PairStore& add);
 // Stage `groups` in three loops that run in the step's parallel region after the gather:
 // `servo` (the servo's stiffness, one block, while a servo acts), `motion` (one block per group:
 // its force and torque summed in member order, its degrees of freedom advanced) and `moves` (the

@@ -504,4 +504,26 @@ void build_neighbors(State& s) {
   split_idle(s);
 }
 
+void insert_pairs(State& s, const PairStore& add) {
+  if (add.n == 0) return;
+  const PairStore& old = s.pairs;
+  PairStore merged;
+  merged.resize(old.n + add.n);
+  std::size_t i = 0, j = 0;
+  for (std::size_t k = 0; k < merged.n; ++k) {
+    const bool from_old = j >= add.n || (i < old.n && (old.a[i] != add.a[j] ? old.a[i] < add.a[j]
+                                                                            : old.b[i] < add.b[j]));
+    const PairStore& src = from_old ? old : add;
+    const std::size_t o = from_old ? i++ : j++;
+    merged.a[k] = src.a[o];
+    merged.b[k] = src.b[o];
+    merged.copy_history(src, o, k);
+  }
+  merged.fill_padding(s.p.null_a(), s.p.null_b());
+  s.pairs = std::move(merged);
+  build_incidence(s.p.n, s.pairs.a.data(), s.pairs.b.data(), s.pairs.n, s.incidence);
+  s.group_pairs_at = ~std::uint64_t(0);  // the servo's list holds pair indices
+  s.idle_valid = false;                  // a member may have a pair now
+}
+
 }  // namespace asperity::detail

@@ -188,6 +188,31 @@ TEST(Bonds, CompressedBondFailsOnlyAtTenTimesTheStrength) {
   EXPECT_EQ(p.w.contact_count(), 1u);
 }
 
+// A broken bond's pair enters the contact list in the step that breaks it, without a neighbour
+// rebuild (a fracture run breaks bonds on most of its steps; kernels/bonds.cpp, process_breaks),
+// and the contact it leaves acts from the next step on with the contact law's force.
+TEST(Bonds, ABreakListsTheFreedPairWithoutARebuild) {
+  BondMaterial bm;
+  bm.tensile_strength = 0.2;
+  Pair p = bonded_pair(bm, moving({0, 0, -1e-6}));
+  p.w.cycle(1);
+  ASSERT_EQ(p.w.stats().pairs, 0u) << "a bonded pair is not in the contact list";
+  std::uint64_t rebuilds = 0;
+  while (p.w.bond_count() == 1 && p.w.step_count() < 1000000) {
+    rebuilds = p.w.stats().rebuilds;
+    p.w.cycle(1);
+  }
+  ASSERT_EQ(p.w.break_events().size(), 1u);
+  EXPECT_EQ(p.w.stats().rebuilds, rebuilds) << "the breaking step rebuilt nothing";
+  EXPECT_EQ(p.w.stats().pairs, 1u) << "the freed pair is listed at once";
+  p.w.cycle(1);
+  EXPECT_EQ(p.w.stats().rebuilds, rebuilds);
+  const auto c = p.w.contacts();
+  ASSERT_EQ(c.size(), 1u);
+  EXPECT_NEAR(c[0].normal_force, 0.1 * c[0].overlap, 1e-12 * c[0].normal_force) << "Fn = kn U";
+  EXPECT_NEAR(p.w.group_force(p.gb).z, c[0].normal_force, 1e-12 * c[0].normal_force) << "on b, along +z";
+}
+
 TEST(Bonds, ShearBreaksAtFiveTimesTheStrength) {
   // Sliding b sideways by dx also turns the bond and stretches it, giving a tension
   // sigma ~ 5 (dx / d) tau; with a strength this small, dx / d ~ 2e-4 at failure, so
