@@ -434,8 +434,8 @@ local summary = {
   residual_bond_stress = residual,
   young_modulus_pa = E, poisson_ratio = nu,
   young_modulus_slab_pa = E_slab, poisson_ratio_slab = nu_slab,
-  shear_modulus_isotropic_pa = E / (2 * (1 + nu)),
-  shear_modulus_isotropic_slab_pa = E_slab / (2 * (1 + nu_slab)),
+  shear_modulus_isotropic_pa = E and nu and E / (2 * (1 + nu)),  -- nil without the elastic test
+  shear_modulus_isotropic_slab_pa = E_slab and nu_slab and E_slab / (2 * (1 + nu_slab)),
   elastic = elastic, shear = shear,
   stress_scale = scale, young_modulus_rock_pa = mat.rock.young_modulus,
   bond_tensile_strength_pa = P.tensile_strength,
@@ -467,10 +467,10 @@ if fracture then
 end
 summary.seconds = asperity.wall_time() - clock0
 asperity.write_json(out .. "/summary.json", summary)
-log("E = %.4g Pa, nu = %.3f, G = %s Pa (E/2(1+nu) = %.4g), scale %.4g", E, nu,
-    shear and ("%.4g"):format(shear.shear_modulus_pa) or "-", summary.shear_modulus_isotropic_pa, scale)
+local function v(x, fmt) return x and (fmt):format(x) or "-" end  -- "-": the test was not run
+log("E = %s Pa, nu = %s, G = %s Pa (E/2(1+nu) = %s), scale %.4g", v(E, "%.4g"), v(nu, "%.3f"),
+    v(shear and shear.shear_modulus_pa, "%.4g"), v(summary.shear_modulus_isotropic_pa, "%.4g"), scale)
 if fracture then
-  local function v(x, fmt) return x and (fmt):format(x) or "-" end
   log("sc = %s Pa = %s MPa, st = %s Pa = %s MPa, ratio %s", v(summary.compressive_strength_pa, "%.4g"),
       v(summary.compressive_strength_mpa, "%.2f"), v(summary.tensile_strength_pa, "%.4g"),
       v(summary.tensile_strength_mpa, "%.2f"), v(summary.strength_ratio, "%.2f"))
