@@ -113,8 +113,9 @@ struct State {
   // The particles holding a bond the step computes (frozen ones aside; refresh_bond_topology):
   // the bond stage checks their angular velocities each step (kernels/bonds.cpp, bond_stage).
   std::vector<std::int32_t> bonded_particles;
-  // Contacts that a broken bond leaves behind (overlapping pairs with their capped shear force):
-  // merged into the pair list at the next rebuild, which a break always triggers.
+  // Contacts that a broken bond left behind, waiting for a rebuild to merge them into the pair
+  // list: only a checkpoint written before breaks entered the list at once (process_breaks,
+  // insert_pairs) can hold some; the first rebuild after loading takes them.
   PairStore inherited;
   std::vector<BreakEvent> break_events;
   std::vector<double> bond_block_breaks;
@@ -234,6 +235,10 @@ BondStore all_bonds(const State& s);
 void build_incidence(std::size_t particles, const std::int64_t* a, const std::int64_t* b,
                      std::size_t count, Incidence& inc);
 void gather_and_integrate(State& s);    // kernels/integrate.cpp
+// neighbor/build.cpp: pair k of q (a and b set) as the search starts a new one: the current
+// direction as its previous normal, no shear or normal force, no rest overlap. Returns the
+// centres' distance.
+double start_pair(PairStore& q, std::size_t k, const ParticleStore& p);
 // neighbor/build.cpp: pairs the list lacks (sorted by (a, b), with their history) merged into it
 // between two rebuilds; the incidence is rebuilt and the group split redone at the next step.
 void insert_pairs(State& s, const PairStore& add);

@@ -274,8 +274,7 @@ void process_breaks(State& s) {
   freed.resize(inherit.size());
   for (std::size_t t = 0; t < inherit.size(); ++t) {
     const std::size_t k = inherit[t];
-    const auto a = q.a[k], b = q.b[k];
-    freed.a[t] = a; freed.b[t] = b;
+    freed.a[t] = q.a[k]; freed.b[t] = q.b[k];
     freed.overlap[t] = q.overlap[k];
     if (q.overlap[k] > 0) {
       const double scale = bond_energy(s, k).capped_fs_scale;
@@ -286,12 +285,7 @@ void process_breaks(State& s) {
       // becomes an ordinary contact, which never pulls.
       freed.rest[t] = std::max(q.rest[k], 0.0);
     } else {
-      const double dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];
-      const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
-      freed.nx[t] = d > 0 ? dx / d : 1.0;
-      freed.ny[t] = d > 0 ? dy / d : 0.0;
-      freed.nz[t] = d > 0 ? dz / d : 0.0;
-      freed.fsx[t] = freed.fsy[t] = freed.fsz[t] = freed.fn[t] = freed.rest[t] = 0;
+      start_pair(freed, t, p);  // the overlap stays the bond's last, as for a touching one
     }
   }
   kept.n = n;

@@ -355,15 +355,7 @@ void build_pairs(State& s, const CellGrid& g) {
       const double dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];
       fresh.overlap[k] = p.radius[a] + p.radius[b] - std::sqrt(dx * dx + dy * dy + dz * dz);
     } else {
-      // New pair: no shear force; its "previous normal" is the current direction.
-      const double dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];
-      const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
-      fresh.nx[k] = d > 0 ? dx / d : 1.0;
-      fresh.ny[k] = d > 0 ? dy / d : 0.0;
-      fresh.nz[k] = d > 0 ? dz / d : 0.0;
-      fresh.fsx[k] = fresh.fsy[k] = fresh.fsz[k] = 0;
-      fresh.fn[k] = fresh.rest[k] = 0;
-      fresh.overlap[k] = p.radius[a] + p.radius[b] - d;
+      fresh.overlap[k] = p.radius[a] + p.radius[b] - start_pair(fresh, k, p);
     }
   }
   // Contacts left behind by broken bonds take over their capped shear force.
@@ -502,6 +494,18 @@ void build_neighbors(State& s) {
   ++s.rebuilds_since_reorder;
   s.need_rebuild = false;
   split_idle(s);
+}
+
+double start_pair(PairStore& q, std::size_t k, const ParticleStore& p) {
+  const auto a = q.a[k], b = q.b[k];
+  const double dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];
+  const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
+  q.nx[k] = d > 0 ? dx / d : 1.0;
+  q.ny[k] = d > 0 ? dy / d : 0.0;
+  q.nz[k] = d > 0 ? dz / d : 0.0;
+  q.fsx[k] = q.fsy[k] = q.fsz[k] = 0;
+  q.fn[k] = q.rest[k] = 0;
+  return d;
 }
 
 void insert_pairs(State& s, const PairStore& add) {

@@ -165,7 +165,9 @@ TEST(History, TheReorderPutsFreeParticlesBeforeGroupMembersAndInertOnesLast) {
   std::size_t counts[3] = {0, 0, 0};
   for (std::size_t i = 0; i < p.n; ++i) {
     ++counts[klass(i)];
-    if (i > 0) ASSERT_LE(klass(i - 1), klass(i)) << "index " << i;
+    if (i > 0) {
+      ASSERT_LE(klass(i - 1), klass(i)) << "index " << i;
+    }
   }
   EXPECT_EQ(counts[0], 384u);
   EXPECT_EQ(counts[1], 128u - 32u);
