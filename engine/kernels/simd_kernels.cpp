@@ -24,22 +24,32 @@ struct SimdLanes {
   static Index index(const std::int64_t* p) { return Index::load_aligned(p); }
   // xsimd 8's batch::gather passes two explicit template arguments to its kernels, which rules
   // out its own AVX2 / AVX-512 double overloads and falls back to inserting lane by lane (a
-  // quarter of the lattice step's time). Call the hardware gathers directly where they exist.
+  // quarter of the lattice step's time). The hardware gathers are slower still on AMD's cores:
+  // Zen 2/3 microcode the AVX2 gather at about twice the cost of four scalar loads (0.84x of the
+  // lattice step), and on Zen 5 eight scalar loads beat the AVX-512 gather too (lattice n = 40
+  // 0.90-0.94x, bonded block 0.81x, joint 0.90x; perf/README.md). Same values, bit for bit.
   static Real gather(const double* col, const Index& i) {
 #if defined(__AVX512F__)
-    return _mm512_i64gather_pd(i, col, 8);
+    alignas(64) std::int64_t k[8];
+    _mm512_store_si512(k, i);
+    const __m256d lo = four_loads(col, k), hi = four_loads(col, k + 4);
+    return _mm512_insertf64x4(_mm512_castpd256_pd512(lo), hi, 1);
 #elif defined(__AVX2__)
-    // Four scalar loads: AMD's Zen 2/3 microcode the AVX2 gather at about twice the cost
-    // (perf/README.md: 0.84x of the lattice step with this, bitwise the same).
     alignas(32) std::int64_t k[4];
     _mm256_store_si256(reinterpret_cast<__m256i*>(k), i);
-    const __m128d lo = _mm_loadh_pd(_mm_load_sd(col + k[0]), col + k[1]);
-    const __m128d hi = _mm_loadh_pd(_mm_load_sd(col + k[2]), col + k[3]);
-    return _mm256_insertf128_pd(_mm256_castpd128_pd256(lo), hi, 1);
+    return four_loads(col, k);
 #else
     return Real::gather(col, i);
 #endif
   }
+#if defined(__AVX2__)
+  // col[k[0..3]] by four scalar loads, as one 256-bit vector.
+  static __m256d four_loads(const double* col, const std::int64_t* k) {
+    const __m128d lo = _mm_loadh_pd(_mm_load_sd(col + k[0]), col + k[1]);
+    const __m128d hi = _mm_loadh_pd(_mm_load_sd(col + k[2]), col + k[3]);
+    return _mm256_insertf128_pd(_mm256_castpd128_pd256(lo), hi, 1);
+  }
+#endif
   // a_side.hpp: lane offsets from the batch's first a, whether all lie in [0, size), and the
   // window load permuted by them. SSE has no variable double permutation: it always gathers.
   static Index offsets(const Index& i, std::int64_t first) { return i - Index(first); }
