@@ -75,6 +75,7 @@ inline void ball_ball_geometry(const F32& xa, const F32& ya, const F32& za, cons
 }
 
 struct FloatLanes {
+  static constexpr bool kOnePass = false;  // pair_loop.hpp
   using Real = F32;
   using Index = std::int64_t;
   static constexpr std::size_t size = 1;

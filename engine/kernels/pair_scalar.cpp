@@ -7,6 +7,7 @@ namespace asperity::kernels {
 namespace {
 
 struct ScalarLanes {
+  static constexpr bool kOnePass = false;  // pair_loop.hpp
   using Real = double;
   using Index = std::int64_t;
   static constexpr std::size_t size = 1;

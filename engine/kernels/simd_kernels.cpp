@@ -21,6 +21,9 @@ struct SimdLanes {
   using Real = xsimd::batch<double, Arch>;
   using Index = xsimd::batch<std::int64_t, Arch>;
   static constexpr std::size_t size = Real::size;
+  // The pair loop in one pass over touching stages on AVX-512 machines, two on the others
+  // (pair_loop.hpp: each measured on its machine, perf/README.md).
+  static constexpr bool kOnePass = size == 8;
   static Index index(const std::int64_t* p) { return Index::load_aligned(p); }
   // xsimd 8's batch::gather passes two explicit template arguments to its kernels, which rules
   // out its own AVX2 / AVX-512 double overloads and falls back to inserting lane by lane (a
