@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdint>
 
+#include "core/cache.hpp"
 #include "state.hpp"
 
 namespace asperity::detail {
@@ -33,6 +34,23 @@ namespace {
 // soon where things do turn (the lattice). Where the pairs are few against the particles (a rigid
 // joint: ~160 pairs at the interface of two bodies of ~1400 particles), their two particles are
 // checked instead, which is the same question asked of fewer particles.
+// Records past the caches are written with non-temporal stores: the gather reads them out of
+// order long after (and prefetches them, integrate.cpp), so the lines need not be read for
+// ownership first. Where they would still be in cache it costs. Measured per machine in one
+// process (perf/README.md):
+// - AVX2 (Zen 3): above 4 MB; lattice n = 40 0.91-0.96 on one thread, 0.86-0.91 on two; n = 46
+//   0.90; in cache (n = 22) 1.16.
+// - AVX-512 (Zen 5, 32 MB L3, 1 MB L2 a core): past a third of the last-level cache on one thread
+//   (n = 30, 5 MB of records: 1.11; n = 34, 7.5 MB: 1.05; n = 40, 12 MB: 0.94; n = 70: 0.85), past
+//   the whole of it on two or more (n = 46, 19 MB: 1.04-1.09; n = 52, 26 MB: 1.13; n = 60, 41 MB:
+//   0.80; n = 100: 0.87), where the two cores' caches hold more of the step.
+bool stream_pair_records(const State& s) {
+  const std::size_t bytes = s.pairs.out.size() * sizeof(double);
+  if (s.kernels->lanes != 8) return records_past_caches(s.pairs.out);
+  const std::size_t cache = last_level_cache_bytes();
+  return thread_count(s) > 1 ? bytes > cache : bytes > cache / 3;
+}
+
 bool pairs_can_spin(const State& s) {
   if (!s.any_rotating) return false;
   const ParticleStore& p = s.p;
@@ -59,11 +77,7 @@ bool pairs_can_spin(const State& s) {
 
 StageLoop pair_stage(State& s) {
   auto args = pair_kernel_args(s);
-  // Records past the caches are written with non-temporal stores: the gather reads them out of
-  // order long after (and prefetches them, integrate.cpp), so the lines need not be read for
-  // ownership first. AVX2 machine of perf/README.md, in one process: lattice n = 40 0.91-0.96 on
-  // one thread, 0.86-0.91 on two; n = 46 0.90. In cache it would cost (n = 22: 1.16).
-  args.stream = records_past_caches(s.pairs.out);
+  args.stream = stream_pair_records(s);
   const auto kernel = pairs_can_spin(s) ? s.kernels->pair : s.kernels->pair_norot;
   const std::size_t total = s.pairs.padded;
   s.pairs.outputs_in_records = true;  // the kernel writes fn and U to the records only

@@ -102,9 +102,9 @@ struct SimdLanes {
   // Records (store/pairs.hpp, store/bonds.hpp): v[j] holds value j of the batch's pairs or bonds;
   // the Width values of item p go to rec[Width p .. Width p + Width - 1]. A transpose of the rows,
   // then full-line stores per item (half lines on AVX2, quarters on SSE). rec is 64-byte
-  // aligned for Width 8, 32-byte aligned for Width 12. Stream: non-temporal stores on AVX2 (for
-  // record arrays past the caches, whose lines then need no read for ownership; measured there
-  // only), plain ones elsewhere.
+  // aligned for Width 8, 32-byte aligned for Width 12. Stream: non-temporal stores (record arrays
+  // past the caches, whose lines then need no read for ownership: pairs.cpp) on AVX2 and, for
+  // records of 8, AVX-512; plain ones elsewhere.
   template <int Width, bool Stream = false>
   static void store_records(double* rec, const Real* v) {
     static_assert(Width == 8 || Width == 12, "records of 8 or 12 values");
@@ -124,8 +124,13 @@ struct SimdLanes {
     const __m512d w[4] = {_mm512_permutex2var_pd(t4, lo, t6), _mm512_permutex2var_pd(t5, lo, t7),
                           _mm512_permutex2var_pd(t4, hi, t6), _mm512_permutex2var_pd(t5, hi, t7)};
     for (int p = 0; p < 4; ++p) {
-      _mm512_storeu_pd(rec + Width * p, _mm512_shuffle_f64x2(u[p], w[p], 0x44));
-      _mm512_storeu_pd(rec + Width * (p + 4), _mm512_shuffle_f64x2(u[p], w[p], 0xEE));
+      if constexpr (Stream && Width == 8) {  // whole 64-byte lines, 64-byte aligned
+        _mm512_stream_pd(rec + Width * p, _mm512_shuffle_f64x2(u[p], w[p], 0x44));
+        _mm512_stream_pd(rec + Width * (p + 4), _mm512_shuffle_f64x2(u[p], w[p], 0xEE));
+      } else {
+        _mm512_storeu_pd(rec + Width * p, _mm512_shuffle_f64x2(u[p], w[p], 0x44));
+        _mm512_storeu_pd(rec + Width * (p + 4), _mm512_shuffle_f64x2(u[p], w[p], 0xEE));
+      }
     }
     if constexpr (Width == 12) {  // values 8..11: quarter lines
       const __m512d s0 = _mm512_unpacklo_pd(v[8], v[9]), s1 = _mm512_unpackhi_pd(v[8], v[9]);
