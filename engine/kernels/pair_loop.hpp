@@ -11,25 +11,6 @@
 
 namespace asperity::kernels {
 
-// The contact law of one pair is a chain of some 150 dependent operations (two square roots,
-// three divisions) in a body of ~400 instructions, more than the out-of-order window of a core
-// holds, so consecutive batches hardly overlap. The loop therefore runs in two passes over
-// stages of kPairStage pairs: geometry and kinematics (positions and velocities in, n, U, Vs,
-// phi out to an L1 scratch), then the response (history in, forces and records out). Each body
-// is about half as long; the operations are those of contact_forces, so the results are the
-// same bit for bit.
-//
-// On AVX-512 machines (Zen 5 here) the touching stages run in one pass instead (Lanes::kOnePass):
-// the larger out-of-order window overlaps the batches of the whole law, and the scratch's stores
-// and loads go (lattice n = 40: 0.91-0.93 of the step on one thread, ~0.975 on two;
-// perf/README.md). Same operations, same bits.
-//
-// A stage in which no pair touches (U <= 0 for all its pairs) skips the law in pass 2: the law
-// would select zero shear force, zero slip energy and a zero rest overlap for each of them, and
-// fn and the record follow from those zeros by the same expressions. In a bonded specimen nearly
-// every listed pair is such a near miss (its touching pairs became bonds: 23 of the joint's 4070
-// pairs touch in mid-shear). The choice is per stage, not per batch, so that a scene in which
-// everything touches runs the loop it ran before (per batch it cost the lattice 2-3 %).
 // Every store of batch i: the history (normal, shear force), the rest overlap, and the record.
 template <class Lanes, class T = typename Lanes::Real>
 inline void store_pair(const PairKernelArgs& k, std::size_t i, const T& nx, const T& ny,
@@ -50,6 +31,25 @@ inline void store_pair(const PairKernelArgs& k, std::size_t i, const T& nx, cons
     Lanes::template store_records<8>(k.out + 8 * i, record);
 }
 
+// The contact law of one pair is a chain of some 150 dependent operations (two square roots,
+// three divisions) in a body of ~400 instructions, more than the out-of-order window of a core
+// holds, so consecutive batches hardly overlap. The loop therefore runs in two passes over
+// stages of kPairStage pairs: geometry and kinematics (positions and velocities in, n, U, Vs,
+// phi out to an L1 scratch), then the response (history in, forces and records out). Each body
+// is about half as long; the operations are those of contact_forces, so the results are the
+// same bit for bit.
+//
+// On AVX-512 machines (Zen 5 here) the touching stages run in one pass instead (Lanes::kOnePass):
+// the larger out-of-order window overlaps the batches of the whole law, and the scratch's stores
+// and loads go (lattice n = 40: 0.91-0.93 of the step on one thread, ~0.975 on two;
+// perf/README.md). Same operations, same bits.
+//
+// A stage in which no pair touches (U <= 0 for all its pairs) skips the law in pass 2: the law
+// would select zero shear force, zero slip energy and a zero rest overlap for each of them, and
+// fn and the record follow from those zeros by the same expressions. In a bonded specimen nearly
+// every listed pair is such a near miss (its touching pairs became bonds: 23 of the joint's 4070
+// pairs touch in mid-shear). The choice is per stage, not per batch, so that a scene in which
+// everything touches runs the loop it ran before (per batch it cost the lattice 2-3 %).
 template <class Lanes, bool Rotation>
 double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
   using T = typename Lanes::Real;
