@@ -84,6 +84,10 @@ struct PlaneWallArgs {
   const double* pvx; const double* pvy; const double* pvz;
   const double* kn; const double* ks; const double* friction;
   double dt;
+  // Walls in the per-wall columns px..friction, each then readable to at least kMaxLanes entries
+  // (zero padding): with no more walls than lanes, a lane permutation of the column replaces
+  // the gather (Lanes::lookup). 0: not padded, always gathered.
+  std::size_t walls = 0;
 };
 
 using PlaneWallKernel = void (*)(const PlaneWallArgs&, std::size_t begin, std::size_t end);

@@ -13,6 +13,7 @@ struct ScalarLanes {
   static constexpr std::size_t size = 1;
   static std::int64_t index(const std::int64_t* p) { return *p; }
   static double gather(const double* col, std::int64_t i) { return col[i]; }
+  static double lookup(const double* table, std::int64_t i, std::size_t) { return table[i]; }
   // One lane: the window is the particle itself (a_side.hpp).
   static std::int64_t offsets(std::int64_t i, std::int64_t first) { return i - first; }
   static bool fits(std::int64_t off) { return off == 0; }

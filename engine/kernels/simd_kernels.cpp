@@ -53,6 +53,17 @@ struct SimdLanes {
     return _mm256_insertf128_pd(_mm256_castpd128_pd256(lo), hi, 1);
   }
 #endif
+  // Entry i of a small table (wall_loop.hpp: a column per wall, readable to kMaxLanes entries
+  // when `entries` > 0): a lane permutation of the whole table where it has no more entries than
+  // lanes (AVX2, AVX-512), else a gather. The same values.
+  static Real lookup(const double* table, const Index& i, std::size_t entries) {
+#if defined(__AVX2__)
+    if (entries > 0 && entries <= size) return window(table, i);
+#else
+    (void)entries;
+#endif
+    return gather(table, i);
+  }
   // a_side.hpp: lane offsets from the batch's first a, whether all lie in [0, size), and the
   // window load permuted by them. SSE has no variable double permutation: it always gathers.
   static Index offsets(const Index& i, std::int64_t first) { return i - Index(first); }

@@ -18,10 +18,12 @@ void plane_wall_loop(const PlaneWallArgs& k, std::size_t begin, std::size_t end)
     const auto iw = Lanes::index32(k.wall + i);
     const T x = Lanes::gather(k.x, ip), y = Lanes::gather(k.y, ip), z = Lanes::gather(k.z, ip);
     const T r = Lanes::gather(k.radius, ip);
-    const T nx = Lanes::gather(k.pnx, iw), ny = Lanes::gather(k.pny, iw), nz = Lanes::gather(k.pnz, iw);
+    const T nx = Lanes::lookup(k.pnx, iw, k.walls), ny = Lanes::lookup(k.pny, iw, k.walls),
+            nz = Lanes::lookup(k.pnz, iw, k.walls);
     // Signed distance of the centre from the plane, along its normal.
-    const T d = (x - Lanes::gather(k.px, iw)) * nx + (y - Lanes::gather(k.py, iw)) * ny +
-                (z - Lanes::gather(k.pz, iw)) * nz;
+    const T d = (x - Lanes::lookup(k.px, iw, k.walls)) * nx +
+                (y - Lanes::lookup(k.py, iw, k.walls)) * ny +
+                (z - Lanes::lookup(k.pz, iw, k.walls)) * nz;
     const T U = r - d;
     const T lb = r - 0.5 * U;
     const T vbx = Lanes::gather(k.vx, ip), vby = Lanes::gather(k.vy, ip), vbz = Lanes::gather(k.vz, ip);
@@ -29,7 +31,8 @@ void plane_wall_loop(const PlaneWallArgs& k, std::size_t begin, std::size_t end)
     if constexpr (Rotation) {
       wbx = Lanes::gather(k.wx, ip); wby = Lanes::gather(k.wy, ip); wbz = Lanes::gather(k.wz, ip);
     }
-    const T vax = Lanes::gather(k.pvx, iw), vay = Lanes::gather(k.pvy, iw), vaz = Lanes::gather(k.pvz, iw);
+    const T vax = Lanes::lookup(k.pvx, iw, k.walls), vay = Lanes::lookup(k.pvy, iw, k.walls),
+            vaz = Lanes::lookup(k.pvz, iw, k.walls);
     // A fresh contact (zero normal stored) starts from the current normal.
     T ox = Lanes::load_u(k.nx + i), oy = Lanes::load_u(k.ny + i), oz = Lanes::load_u(k.nz + i);
     const auto fresh = (ox * ox + oy * oy + oz * oz) == T(0.0);
@@ -37,8 +40,8 @@ void plane_wall_loop(const PlaneWallArgs& k, std::size_t begin, std::size_t end)
     oy = select(fresh, ny, oy);
     oz = select(fresh, nz, oz);
     T fx = Lanes::load_u(k.fsx + i), fy = Lanes::load_u(k.fsy + i), fz = Lanes::load_u(k.fsz + i), fn;
-    const LawParams<T> law{Lanes::gather(k.kn, iw), Lanes::gather(k.ks, iw),
-                           Lanes::gather(k.friction, iw), T(k.dt)};
+    const LawParams<T> law{Lanes::lookup(k.kn, iw, k.walls), Lanes::lookup(k.ks, iw, k.walls),
+                           Lanes::lookup(k.friction, iw, k.walls), T(k.dt)};
     const T zero(0.0);
     // Without rotation both sides have w = +0: the law without spin (contact_law.hpp).
     const T slip = contact_forces<T, Rotation>(nx, ny, nz, U, zero, lb, vax, vay, vaz, zero, zero,

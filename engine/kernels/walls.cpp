@@ -202,6 +202,10 @@ StageLoop wall_stage(State& s) {
       t.plane.push_back(w.kind == Wall::Kind::plane ? 1 : 0);
       t.moved.push_back(norm(w.displacement - w.displacement_at_build));
     }
+    // Readable to kMaxLanes entries for the kernel's lane permutations (PlaneWallArgs::walls).
+    for (auto* c : {&t.px, &t.py, &t.pz, &t.nx, &t.ny, &t.nz, &t.vx, &t.vy, &t.vz, &t.kn, &t.ks,
+                    &t.friction})
+      c->resize(std::max(nw, kMaxLanes), 0.0);
   }
   const ParticleStore& p = s.p;
   const kernels::PlaneWallArgs plane_args{
@@ -211,7 +215,7 @@ StageLoop wall_stage(State& s) {
       wc.fn.data(), wc.overlap.data(), wc.slip.data(), sums->px.data(), sums->py.data(),
       sums->pz.data(), sums->nx.data(), sums->ny.data(), sums->nz.data(), sums->vx.data(),
       sums->vy.data(), sums->vz.data(), sums->kn.data(), sums->ks.data(),
-      sums->friction.data(), s.dt};
+      sums->friction.data(), s.dt, nw};
   const bool rot = s.any_rotating;
   const auto plane_kernel = rot ? s.kernels->plane_walls : s.kernels->plane_walls_norot;
   const auto plane_tail = rot ? kernels::scalar_kernels().plane_walls

@@ -529,14 +529,19 @@ TEST(Determinism, IntegrateWithoutSpinIsTheFullKernelWhereNothingTurns) {
 namespace {
 // Random ball-plane contacts in every state: touching or not, fresh (zero stored normal) or
 // carrying a shear force that sticks or slides, spinning, on moving planes of different
-// materials; a count that is not a multiple of the lanes.
+// materials; a count that is not a multiple of the lanes. tables: the per-wall columns padded
+// with zeros to 8 entries and their count given (PlaneWallArgs::walls), so that kernels with at
+// least as many lanes as walls permute them instead of gathering.
 struct RandomPlaneContacts {
-  static constexpr std::size_t n = 1003, particles = 700, walls = 5;
+  static constexpr std::size_t n = 1003, particles = 700;
+  std::size_t walls;
+  bool tables;
   std::vector<double> x, y, z, vx, vy, vz, wx, wy, wz, r;
   std::vector<std::int32_t> particle, wall;
   std::vector<double> nx, ny, nz, fsx, fsy, fsz, fn, U, slip;
   std::vector<double> px, py, pz, pnx, pny, pnz, pvx, pvy, pvz, kn, ks, mu;
-  explicit RandomPlaneContacts(unsigned seed) {
+  explicit RandomPlaneContacts(unsigned seed, std::size_t wall_count = 5, bool padded = false)
+      : walls(wall_count), tables(padded) {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> u(-1, 1);
     for (std::size_t w = 0; w < walls; ++w) {
@@ -573,13 +578,16 @@ struct RandomPlaneContacts {
       fsx.push_back(s * u(rng)); fsy.push_back(s * u(rng)); fsz.push_back(s * u(rng));
     }
     fn.assign(n, -1); U.assign(n, -1); slip.assign(n, -1);
+    if (tables)
+      for (auto* c : {&px, &py, &pz, &pnx, &pny, &pnz, &pvx, &pvy, &pvz, &kn, &ks, &mu})
+        c->resize(std::max<std::size_t>(walls, 8), 0.0);
   }
   kernels::PlaneWallArgs args() {
     return {x.data(), y.data(), z.data(), vx.data(), vy.data(), vz.data(), wx.data(), wy.data(),
             wz.data(), r.data(), particle.data(), wall.data(), nx.data(), ny.data(), nz.data(),
             fsx.data(), fsy.data(), fsz.data(), fn.data(), U.data(), slip.data(), px.data(),
             py.data(), pz.data(), pnx.data(), pny.data(), pnz.data(), pvx.data(), pvy.data(),
-            pvz.data(), kn.data(), ks.data(), mu.data(), 1e-3};
+            pvz.data(), kn.data(), ks.data(), mu.data(), 1e-3, tables ? walls : 0};
   }
 };
 }  // namespace
@@ -588,8 +596,11 @@ TEST(Determinism, SimdPlaneWallKernelEqualsTheScalarReferenceBitwise) {
   using C = RandomPlaneContacts;
   for (const auto& arch : available_simd_architectures()) {
     const auto& simd = kernels::select_kernels(arch);
+    // Gathered tables, and permuted ones where the lanes hold every wall (3 <= 4 lanes of AVX2,
+    // 5 <= 8 of AVX-512; 12 walls are gathered on every architecture).
+    for (auto [walls, tables] : {std::pair<std::size_t, bool>{5, false}, {5, true}, {3, true}, {12, true}})
     for (bool rotation : {true, false}) {
-      C ref(5), got(5);
+      C ref(5, walls, tables), got(5, walls, tables);
       const auto& sk = kernels::scalar_kernels();
       (rotation ? sk.plane_walls : sk.plane_walls_norot)(ref.args(), 0, C::n);
       // Whole batches from an odd start, as the wall stage calls it on runs of plane contacts;
@@ -598,7 +609,8 @@ TEST(Determinism, SimdPlaneWallKernelEqualsTheScalarReferenceBitwise) {
       (rotation ? sk.plane_walls : sk.plane_walls_norot)(got.args(), 0, begin);
       (rotation ? simd.plane_walls : simd.plane_walls_norot)(got.args(), begin, whole);
       (rotation ? sk.plane_walls : sk.plane_walls_norot)(got.args(), whole, C::n);
-      const std::string what = arch + (rotation ? " rotation" : " no rotation");
+      const std::string what = arch + (rotation ? " rotation" : " no rotation") + ", " +
+                               std::to_string(walls) + (tables ? " walls in tables" : " walls");
       auto same = [](const std::vector<double>& u, const std::vector<double>& v) {
         return std::memcmp(u.data(), v.data(), u.size() * sizeof(double)) == 0;
       };
