@@ -231,6 +231,9 @@ void refresh_bond_topology(State& s);   // kernels/bonds.cpp: incidence, partner
 bool settle_frozen_bonds(State& s);
 // Every bond, active and frozen, in one store sorted by (a, b) (checkpoints).
 BondStore all_bonds(const State& s);
+// x and y (each sorted by (a, b), no bond in both) in one store sorted by (a, b); its material
+// and `any` are left to the caller (kernels/bonds.cpp).
+BondStore merge_bonds(const BondStore& x, const BondStore& y);
 // CSR of the pairs (a, b) per particle, entries (k << 1) | (particle is b), ascending k.
 void build_incidence(std::size_t particles, const std::int64_t* a, const std::int64_t* b,
                      std::size_t count, Incidence& inc);

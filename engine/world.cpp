@@ -621,42 +621,32 @@ std::size_t World::install_bonds(const BondMaterial& material, double tolerance,
     const double gap = std::sqrt(dx * dx + dy * dy + dz * dz) - p.radius[a] - p.radius[b];
     if (gap <= tolerance) picked.push_back(k);
   }
-  // Merge the new bonds into the sorted bond list (pairs are sorted by (a, b), so is `picked`).
-  detail::BondStore merged;
-  merged.material = material;
-  merged.any = true;
-  merged.resize(s.bonds.n + picked.size());
-  std::size_t i = 0, j = 0, k = 0;
-  const auto& old = s.bonds;
-  while (i < old.n || j < picked.size()) {
-    const bool take_old = j == picked.size() ||
-                          (i < old.n && (old.a[i] < q.a[picked[j]] ||
-                                         (old.a[i] == q.a[picked[j]] && old.b[i] < q.b[picked[j]])));
-    if (take_old) {
-      merged.copy_from(old, i++, k++);
-      continue;
-    }
-    const std::size_t c = picked[j++];
+  // The new bonds, in the pair list's (a, b) order, merged into the sorted bond list.
+  detail::BondStore fresh;
+  fresh.resize(picked.size());
+  for (std::size_t k = 0; k < picked.size(); ++k) {
+    const std::size_t c = picked[k];
     const auto a = q.a[c], b = q.b[c];
     const double dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];
     const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
-    merged.a[k] = a;
-    merged.b[k] = b;
-    merged.beam_radius[k] = material.radius_factor * std::min(p.radius[a], p.radius[b]);  // [3-26]
-    merged.nx[k] = dx / d; merged.ny[k] = dy / d; merged.nz[k] = dz / d;
+    fresh.a[k] = a;
+    fresh.b[k] = b;
+    fresh.beam_radius[k] = material.radius_factor * std::min(p.radius[a], p.radius[b]);  // [3-26]
+    fresh.nx[k] = dx / d; fresh.ny[k] = dy / d; fresh.nz[k] = dz / d;
     // An existing contact's forces are kept by the contact bond (model.md 5); stress-free, the
     // contact bond is unloaded at the current overlap instead. The beam starts unloaded.
-    merged.fsx[k] = stress_free ? 0.0 : q.fsx[c];
-    merged.fsy[k] = stress_free ? 0.0 : q.fsy[c];
-    merged.fsz[k] = stress_free ? 0.0 : q.fsz[c];
-    merged.overlap[k] = p.radius[a] + p.radius[b] - d;
-    merged.rest[k] = stress_free ? merged.overlap[k] : 0.0;
-    merged.fn[k] = s.settings.contact.kn * (merged.overlap[k] - merged.rest[k]);
-    merged.fbn[k] = merged.fbsx[k] = merged.fbsy[k] = merged.fbsz[k] = 0;
-    merged.mbn[k] = merged.mbsx[k] = merged.mbsy[k] = merged.mbsz[k] = merged.broken[k] = 0;
-    ++k;
+    fresh.fsx[k] = stress_free ? 0.0 : q.fsx[c];
+    fresh.fsy[k] = stress_free ? 0.0 : q.fsy[c];
+    fresh.fsz[k] = stress_free ? 0.0 : q.fsz[c];
+    fresh.overlap[k] = p.radius[a] + p.radius[b] - d;
+    fresh.rest[k] = stress_free ? fresh.overlap[k] : 0.0;
+    fresh.fn[k] = s.settings.contact.kn * (fresh.overlap[k] - fresh.rest[k]);
+    fresh.fbn[k] = fresh.fbsx[k] = fresh.fbsy[k] = fresh.fbsz[k] = 0;
+    fresh.mbn[k] = fresh.mbsx[k] = fresh.mbsy[k] = fresh.mbsz[k] = fresh.broken[k] = 0;
   }
-  s.bonds = std::move(merged);
+  s.bonds = detail::merge_bonds(s.bonds, fresh);
+  s.bonds.material = material;
+  s.bonds.any = true;
   s.frozen_bonds.material = material;
   s.frozen_bonds.any = true;
   if (stress_free && !picked.empty()) s.rest_overlaps = true;

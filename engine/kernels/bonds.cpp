@@ -112,9 +112,6 @@ void refresh_bond_topology(State& s) {
   }
 }
 
-namespace {
-// x and y (each sorted by (a, b), no bond in both) into one store sorted by (a, b).
-// The material is the world's one (s.bonds.material), set by the caller.
 BondStore merge_bonds(const BondStore& x, const BondStore& y) {
   BondStore out;
   out.resize(x.n + y.n);
@@ -126,7 +123,6 @@ BondStore merge_bonds(const BondStore& x, const BondStore& y) {
   }
   return out;
 }
-}  // namespace
 
 BondStore all_bonds(const State& s) {
   BondStore all = merge_bonds(s.bonds, s.frozen_bonds);
