@@ -604,14 +604,17 @@ std::size_t World::install_bonds(const BondMaterial& material, double tolerance,
     for (std::size_t i = 0; i < p.n; ++i) mean += p.radius[i];
     tolerance = 1e-3 * mean / double(p.n);
   }
-  std::vector<std::uint8_t> chosen(p.n, ids.empty() ? 1 : 0);
-  for (auto id : ids) chosen[index_of(s, id)] = 1;
+  for (auto id : ids) index_of(s, id);  // every id valid before anything changes
   // Candidates come from the neighbour list; make sure it is current and reaches the tolerance.
   // (The skin is derived first: a world never built has none yet, and 2 x tolerance alone, about
   // 1e-3 R, would leave it rebuilding the list at every step.)
   detail::ensure_skin(s);
   if (s.skin < 2 * tolerance) s.skin = 2 * tolerance;
   detail::build_neighbors(s);
+  // The chosen particles by index after the build: it may have reordered the store (marked
+  // before it, other particles were bonded: across the mould of the 4 cm joint).
+  std::vector<std::uint8_t> chosen(p.n, ids.empty() ? 1 : 0);
+  for (auto id : ids) chosen[index_of(s, id)] = 1;
   const auto& q = s.pairs;
   std::vector<std::size_t> picked;
   for (std::size_t k = 0; k < q.n; ++k) {

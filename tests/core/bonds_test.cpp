@@ -2,6 +2,7 @@
 // [3-46..3-49], the released energy, the bonded oscillator, and the SIMD kernel.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -291,6 +292,47 @@ TEST(Bonds, InstallationBondsEveryTouchingPairOnce) {
   BondMaterial bad;
   bad.tensile_strength = 0;
   EXPECT_THROW(w.install_bonds(bad), Error) << "breakable without a strength";
+}
+
+// Bonds for a subset of particles join only particles of that subset, even when the neighbour
+// build inside install_bonds reorders the store (it did: the subset was marked by index before
+// the build, and a reorder there bonded other particles, e.g. across the 4 cm joint's mould).
+TEST(Bonds, InstallationForSomeIdsBondsOnlyThoseWhenTheBuildReorders) {
+  WorldSettings ws;
+  ws.reorder_interval = 1;  // every build after the first reorders
+  World w(ws);
+  const int n = 6;
+  std::vector<Vec3> at;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      for (int k = 0; k < n; ++k) at.push_back({i * 2 * kR, j * 2 * kR, k * 2 * kR});
+  std::vector<std::int64_t> ids;
+  for (const Vec3& x : at) ids.push_back(w.add_particle(x, kR));
+  w.rebuild_neighbors();  // the store in cell order
+  // The particles change places (as a packing moves them), so the next build's reorder permutes
+  // the store.
+  std::mt19937_64 rng(3);
+  std::shuffle(at.begin(), at.end(), rng);
+  std::vector<std::int64_t> lower;
+  std::vector<bool> is_lower(ids.size());
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    w.set_position(ids[k], at[k]);
+    is_lower[std::size_t(ids[k])] = at[k].z < (n / 2) * 2 * kR - kR;
+    if (is_lower[std::size_t(ids[k])]) lower.push_back(ids[k]);
+  }
+  const auto reorders = w.stats().reorders;
+  BondMaterial bm;
+  bm.breakable = false;
+  const std::size_t made = w.install_bonds(bm, -1, lower);
+  EXPECT_GT(w.stats().reorders, reorders) << "the build inside install_bonds must reorder";
+  // The lower half is the n/2 bottom layers: n (n - 1) touching pairs along x and as many along y
+  // in each layer, n^2 between consecutive layers.
+  const std::size_t layers = n / 2;
+  EXPECT_EQ(made, layers * 2 * n * (n - 1) + (layers - 1) * n * n);
+  for (const BondInfo& b : w.bonds()) {
+    EXPECT_TRUE(is_lower[std::size_t(b.id_a)]) << b.id_a;
+    EXPECT_TRUE(is_lower[std::size_t(b.id_b)]) << b.id_b;
+  }
 }
 
 // Bonds installed in a world that never ran keep the world's skin (the search for bonded pairs
