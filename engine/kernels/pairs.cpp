@@ -25,15 +25,6 @@ static_assert(PairStore::kTouchStage == kernels::kPairStage);
 
 namespace {
 
-// Whether some particle the pair list can reach has an angular velocity other than +0. Rotation
-// being possible (any_rotating) does not mean anything turns: in the joint every particle of a
-// pair is bonded (rotation locked, model.md 5) or a member of a platen that does not rotate, and
-// only the inert ones left out after packing, which no pair reaches, keep a spin. Where nothing
-// spins, the law without its spin terms gives the full law's values except for the sign of an
-// exact zero (contact_law.hpp). Chunks of 256 particles, so the scan vectorises and still stops
-// soon where things do turn (the lattice). Where the pairs are few against the particles (a rigid
-// joint: ~160 pairs at the interface of two bodies of ~1400 particles), their two particles are
-// checked instead, which is the same question asked of fewer particles.
 // Records past the caches are written with non-temporal stores: the gather reads them out of
 // order long after (and prefetches them, integrate.cpp), so the lines need not be read for
 // ownership first. Where they would still be in cache it costs. Measured per machine in one
@@ -51,6 +42,15 @@ bool stream_pair_records(const State& s) {
   return thread_count(s) > 1 ? bytes > cache : bytes > cache / 3;
 }
 
+// Whether some particle the pair list can reach has an angular velocity other than +0. Rotation
+// being possible (any_rotating) does not mean anything turns: in the joint every particle of a
+// pair is bonded (rotation locked, model.md 5) or a member of a platen that does not rotate, and
+// only the inert ones left out after packing, which no pair reaches, keep a spin. Where nothing
+// spins, the law without its spin terms gives the full law's values except for the sign of an
+// exact zero (contact_law.hpp). Chunks of 256 particles, so the scan vectorises and still stops
+// soon where things do turn (the lattice). Where the pairs are few against the particles (a rigid
+// joint: ~160 pairs at the interface of two bodies of ~1400 particles), their two particles are
+// checked instead, which is the same question asked of fewer particles.
 bool pairs_can_spin(const State& s) {
   if (!s.any_rotating) return false;
   const ParticleStore& p = s.p;
