@@ -99,22 +99,6 @@ double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
           Lanes::store(scratch[4] + j, vsx); Lanes::store(scratch[5] + j, vsy);
           Lanes::store(scratch[6] + j, vsz); Lanes::store(scratch[7] + j, phi);
         }
-    } else if constexpr (Lanes::kOnePass) {
-      for (std::size_t i = first; i < last; i += Lanes::size) {
-        const BatchSides<T> q = load_sides<Lanes, Rotation>(k, i);
-        T nx, ny, nz, U, la, lb;
-        ball_ball_geometry(q.xa, q.ya, q.za, q.xb, q.yb, q.zb, q.ra, q.rb, nx, ny, nz, U, la, lb);
-        T vn, vsx, vsy, vsz, phi;
-        contact_kinematics<T, Rotation>(nx, ny, nz, la, lb, q.vax, q.vay, q.vaz, q.wax, q.way,
-                                        q.waz, q.vbx, q.vby, q.vbz, q.wbx, q.wby, q.wbz, p.dt, vn,
-                                        vsx, vsy, vsz, phi);
-        reach = select(U > reach, U, reach);
-        respond_batch(i, nx, ny, nz, U, vsx, vsy, vsz, phi);
-      }
-      // A stage that touched nothing after all: its batches got what the no-touch branch below
-      // gives (the law selects zero forces where U <= 0).
-      if (k.touched) k.touched[stage] = any(reach > T(0.0));
-      continue;
     } else {
       for (std::size_t i = first; i < last; i += Lanes::size) {
         const std::size_t j = i - first;
@@ -126,10 +110,20 @@ double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
                                         q.waz, q.vbx, q.vby, q.vbz, q.wbx, q.wby, q.wbz, p.dt, vn,
                                         vsx, vsy, vsz, phi);
         reach = select(U > reach, U, reach);
-        Lanes::store(scratch[0] + j, nx); Lanes::store(scratch[1] + j, ny);
-        Lanes::store(scratch[2] + j, nz); Lanes::store(scratch[3] + j, U);
-        Lanes::store(scratch[4] + j, vsx); Lanes::store(scratch[5] + j, vsy);
-        Lanes::store(scratch[6] + j, vsz); Lanes::store(scratch[7] + j, phi);
+        if constexpr (Lanes::kOnePass) {
+          respond_batch(i, nx, ny, nz, U, vsx, vsy, vsz, phi);
+        } else {
+          Lanes::store(scratch[0] + j, nx); Lanes::store(scratch[1] + j, ny);
+          Lanes::store(scratch[2] + j, nz); Lanes::store(scratch[3] + j, U);
+          Lanes::store(scratch[4] + j, vsx); Lanes::store(scratch[5] + j, vsy);
+          Lanes::store(scratch[6] + j, vsz); Lanes::store(scratch[7] + j, phi);
+        }
+      }
+      if constexpr (Lanes::kOnePass) {
+        // Done in the one pass. A stage that touched nothing after all got what the no-touch
+        // branch below gives (the law selects zero forces where U <= 0).
+        if (k.touched) k.touched[stage] = any(reach > T(0.0));
+        continue;
       }
     }
     auto respond = [&](auto touching) __attribute__((always_inline)) {

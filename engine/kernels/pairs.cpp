@@ -36,8 +36,8 @@ namespace {
 //   the whole of it on two or more (n = 46, 19 MB: 1.04-1.09; n = 52, 26 MB: 1.13; n = 60, 41 MB:
 //   0.80; n = 100: 0.87), where the two cores' caches hold more of the step.
 bool stream_pair_records(const State& s) {
-  const std::size_t bytes = s.pairs.out.size() * sizeof(double);
   if (s.kernels->lanes != 8) return records_past_caches(s.pairs.out);
+  const std::size_t bytes = s.pairs.out.size() * sizeof(double);
   const std::size_t cache = last_level_cache_bytes();
   return thread_count(s) > 1 ? bytes > cache : bytes > cache / 3;
 }
