@@ -89,6 +89,9 @@ struct ParticleBlockResult {
   double max_disp2 = 0;      // squared displacement since the last build
   double worst_step = 0;     // max of |v| dt / R and |w| dt / 0.1 rad (1 = health limit)
   std::int32_t worst = -1;   // its particle index
+  // The block's angular velocities after the stage, bits ORed (State::spin_known): over its
+  // particles that are not inert, and over those that hold a bond the step computes.
+  std::uint64_t spin_reachable = 0, spin_bonded = 0;
 };
 
 struct State {
@@ -121,6 +124,16 @@ struct State {
   std::vector<double> bond_block_breaks;
   std::vector<std::uint8_t> user_rotation_locked;  // set by the API; bonds add their own lock
   bool any_rotating = true;  // some particle can rotate: kernels read angular velocities
+  // Whether a particle spins (an angular velocity other than +0) as the last step left them: the
+  // bits of wx, wy, wz ORed over the particles a pair can reach (not inert), and over the ones
+  // holding a bond the step computes. The gather + integrate stage takes them per block after the
+  // block moved, bookkeep adds the moved group members' new spin. Valid while spin_known: set by
+  // a step that ran with any_rotating, cleared by the API (touch, spins, inert flags, group
+  // motions) and by a new bond topology; the pair and bond stages read them instead of scanning
+  // the particles, serially, every step (on two threads the scans were ~5 % of the joint's step).
+  bool spin_known = false;
+  std::uint64_t spin_reachable = 0, spin_bonded = 0;
+  bool spin_scan_full = false;  // this step's gather + integrate stage took every block's ORs
   // Every bond's beam moments are +-0 (set by a scan in refresh_bond_topology, cleared by a bond
   // stage that runs with spin): only spin makes them grow, so the bond stage may take the kernel
   // that neither carries nor stores them (kernels/bonds.cpp).

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -61,6 +62,30 @@ void bookkeep(State& s) {
       worst = r.worst_step;
       worst_i = r.worst;
     }
+  }
+  // What spins now (State::spin_known): the blocks' ORs, taken after each block moved, and the
+  // moved group members, which took their group's new angular velocity after them (move_members).
+  // A step that started from a known answer adds to it (integrate.cpp: only its blocks with
+  // rotation were read).
+  if (!s.any_rotating) {
+    s.spin_known = false;  // the blocks took no ORs
+  } else if (s.spin_scan_full || s.spin_known) {
+    std::uint64_t reachable = 0, bonded = 0;
+    for (const auto& r : s.particle_blocks) {
+      reachable |= r.spin_reachable;
+      bonded |= r.spin_bonded;
+    }
+    std::uint64_t members = 0;
+    if (!s.groups.empty())
+      for (const GroupStep& gs : s.group_steps)
+        if (gs.moves)
+          members |= std::bit_cast<std::uint64_t>(gs.angular_velocity.x) |
+                     std::bit_cast<std::uint64_t>(gs.angular_velocity.y) |
+                     std::bit_cast<std::uint64_t>(gs.angular_velocity.z);
+    if (s.spin_scan_full) s.spin_reachable = s.spin_bonded = 0;
+    s.spin_reachable |= reachable | members;
+    s.spin_bonded |= bonded | members;
+    s.spin_known = true;
   }
   // Group members were moved by the group stages: the largest displacement of each group (its idle
   // members have moved by at most idle_base + |idle_shift|, split_idle).

@@ -54,6 +54,7 @@ void touch(State& s) {  // the user changed the state: rebuild, re-estimate, re-
   s.need_rebuild = true;  // the rebuild also redoes the busy / idle split of the groups
   s.reference_energy = -1;
   s.kinetic_valid = false;
+  s.spin_known = false;  // the next pair and bond stages scan for spin (State::spin_known)
 }
 
 void recompute_group(State& s, detail::Group& g) {
@@ -267,6 +268,7 @@ void World::set_angular_velocity(std::int64_t id, Vec3 w) {
   p.wz[i] = w.z;
   state_->reference_energy = -1;
   state_->kinetic_valid = false;
+  state_->spin_known = false;
 }
 void World::set_radius(std::int64_t id, double r) {
   require(r > 0 && std::isfinite(r), "radius must be > 0, got " + num(r));
@@ -486,6 +488,7 @@ void World::set_group_motion(int group, const GroupMotion& motion) {
   }
   g.motion = motion;
   state_->idle_valid = false;  // a group that may now rotate has no idle members (the split syncs first)
+  state_->spin_known = false;
 }
 const GroupMotion& World::group_motion(int group) const { return state_->groups[check_group(*state_, group)].motion; }
 void World::set_group_applied_force(int group, Vec3 f) {
@@ -520,6 +523,7 @@ void World::set_inert(std::span<const std::int64_t> ids, bool inert) {
     idx.push_back(i);
   }
   for (auto i : idx) s.p.inert[i] = inert ? 1 : 0;
+  s.spin_known = false;  // a particle a pair can reach now may spin
   for (auto& g : s.groups) {
     std::vector<std::int32_t> all(g.members);
     all.insert(all.end(), g.inert.begin(), g.inert.end());

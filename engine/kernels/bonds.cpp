@@ -75,6 +75,7 @@ void refresh_bond_topology(State& s) {
   q.fill_padding(p.null_a(), p.null_b());
   s.frozen_bonds.fill_padding(p.null_a(), p.null_b());
   ++s.bond_version;
+  s.spin_known = false;  // the bonded particles changed (State::spin_known)
   // The gather's incidence: the bonds the step computes. Partners and rotation locks: every bond
   // (a frozen one still ties its particles).
   build_incidence(p.n, q.a.data(), q.b.data(), q.n, s.bond_incidence);
@@ -181,7 +182,10 @@ StageLoop bond_stage(State& s) {
   // term of the law: the joint's elastic step on one thread costs 6-18 % less for the loads and
   // another 6-22 % for the terms; on two threads the latter did not show (perf/README.md).
   bool spin = s.any_rotating;
-  if (spin) {
+  if (spin && s.spin_known) {
+    // What the last step left for the particles holding a bond (State::spin_known).
+    spin = s.spin_bonded != 0;
+  } else if (spin) {
     const ParticleStore& p = s.p;
     spin = false;
     for (const std::int32_t i : s.bonded_particles)

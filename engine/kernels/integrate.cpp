@@ -13,6 +13,7 @@
 // gather kernels (gather_loop.hpp) read as 256-bit vectors; the wall and applied terms follow in
 // scalar passes. The operations are those the scalar gather did (so the results are bitwise the
 // same).
+#include <bit>
 #include <cmath>
 
 #include "state.hpp"
@@ -105,6 +106,37 @@ StageLoop integrate_stage(State& s) {
   const std::uint8_t* inert = p.inert.data();
   const std::int32_t* group = p.group.data();
   const std::uint8_t* locked = p.rotation_locked.data();
+  // The spin left in particles first..end (State::spin_known), read while their lines are at hand.
+  // Where the last step's answer holds (spin_known), only blocks the kernel with rotation
+  // integrated can add to it: the kernel without rotation and the gather write no w, the group
+  // stages give members their group's (bookkeep adds it). Once something spins the answer cannot
+  // change until it is cleared, so nothing is read then (the lattice, where both say so).
+  const double *wx = p.wx.data(), *wy = p.wy.data(), *wz = p.wz.data();
+  const std::int32_t* bond_start = binc.start.size() > n ? binc.start.data() : nullptr;
+  const bool full = !s.spin_known;
+  s.spin_scan_full = full;
+  const bool track =
+      s.any_rotating && (full || s.spin_reachable == 0 || (bq.n > 0 && s.spin_bonded == 0));
+  auto spin_of = [=](std::size_t first, std::size_t end, ParticleBlockResult& r) {
+    // Branch-free (all-ones masks), so that the loops vectorise.
+    auto bits = [=](std::size_t i) {
+      return std::bit_cast<std::uint64_t>(wx[i]) | std::bit_cast<std::uint64_t>(wy[i]) |
+             std::bit_cast<std::uint64_t>(wz[i]);
+    };
+    auto is_inert = [=](std::size_t i) { return std::uint64_t(0) - std::uint64_t(inert[i] != 0); };
+    std::uint64_t reachable = 0, bonded = 0;
+    if (bond_start) {
+      for (std::size_t i = first; i < end; ++i) {
+        const std::uint64_t b = bits(i);
+        reachable |= b & ~is_inert(i);
+        bonded |= b & (std::uint64_t(0) - std::uint64_t(bond_start[i + 1] > bond_start[i]));
+      }
+    } else {
+      for (std::size_t i = first; i < end; ++i) reachable |= bits(i) & ~is_inert(i);
+    }
+    r.spin_reachable = reachable;
+    r.spin_bonded = bonded;
+  };
   StageLoop st;
   st.blocks = blocks;
   st.after_barrier = true;  // the forces of every stage before it are needed
@@ -115,6 +147,7 @@ StageLoop integrate_stage(State& s) {
       // only the busy members (split_idle) have any.
       for (std::int32_t e = s.block_busy.start[blk]; e < s.block_busy.start[blk + 1]; ++e)
         gather(std::size_t(s.block_busy.entry[e]));
+      if (track && full) spin_of(blk * kParticleBlock, std::min(n, (blk + 1) * kParticleBlock), r);
       s.particle_blocks[blk] = r;
       return;
     }
@@ -160,6 +193,7 @@ StageLoop integrate_stage(State& s) {
     r.max_disp2 = sums.max_disp2;
     r.worst_step = sums.worst_step;
     r.worst = std::int32_t(sums.worst);
+    if (track && (full || spins)) spin_of(first, end, r);
     s.particle_blocks[blk] = r;
   };
   return st;

@@ -50,9 +50,14 @@ bool stream_pair_records(const State& s) {
 // exact zero (contact_law.hpp). Chunks of 256 particles, so the scan vectorises and still stops
 // soon where things do turn (the lattice). Where the pairs are few against the particles (a rigid
 // joint: ~160 pairs at the interface of two bodies of ~1400 particles), their two particles are
-// checked instead, which is the same question asked of fewer particles.
+// checked instead, which is the same question asked of fewer particles. Both scans run only
+// where the last step did not say (State::spin_known: the first step, and after the API changed
+// something); its answer covers every particle that is not inert, so it may say yes where a scan
+// of the pairs would say no, never the reverse.
 bool pairs_can_spin(const State& s) {
   if (!s.any_rotating) return false;
+  // What the last step left (State::spin_known): the particles a pair can reach, or more.
+  if (s.spin_known) return s.spin_reachable != 0;
   const ParticleStore& p = s.p;
   const PairStore& q = s.pairs;
   if (4 * q.n < p.n) {

@@ -799,3 +799,119 @@ TEST(Determinism, UnknownArchitectureIsAClearError) {
     EXPECT_NE(std::string(e.what()).find("scalar"), std::string::npos) << "lists the valid ones";
   }
 }
+
+// Whether anything spins, which picks the pair and bond kernels with or without spin, is taken
+// from the last step (State::spin_known) instead of a scan of the particles each step. Against a
+// twin whose answer is cleared before every step, so that it scans every time, the runs must be
+// the same bit for bit.
+namespace {
+
+std::vector<double> angular_velocities(const World& w) {
+  std::vector<double> out;
+  for (std::int64_t id = 0; id < std::int64_t(w.particle_count()); ++id)
+    for (double c : {w.angular_velocity(id).x, w.angular_velocity(id).y, w.angular_velocity(id).z})
+      out.push_back(c);
+  return out;
+}
+
+void expect_same_run(const World& a, const World& b) {
+  auto same = [](const std::vector<double>& u, const std::vector<double>& v) {
+    return u.size() == v.size() && std::memcmp(u.data(), v.data(), u.size() * sizeof(double)) == 0;
+  };
+  EXPECT_TRUE(same(a.positions(), b.positions()));
+  EXPECT_TRUE(same(a.velocities(), b.velocities()));
+  EXPECT_TRUE(same(angular_velocities(a), angular_velocities(b)));
+  EXPECT_TRUE(same(a.forces(), b.forces()));
+}
+
+}  // namespace
+
+// Loose spheres that start without spin and begin to turn in their frictional contacts: the
+// answer is "nothing spins" for the first steps and must turn to "something does" in the step
+// after the integration first gives a sphere a spin. Then half of them are bonded. By default that
+// locks their rotation and zeroes their spin (model.md 5), and the bond stage's answer is again
+// "nothing spins" while the free half keeps turning; with bonded rotation unlocked the bonded
+// spheres turn too, and the bond stage must see it.
+TEST(Determinism, SpinTakenFromTheLastStepEqualsAScanEveryStep) {
+  for (const bool lock : {true, false}) {
+    SCOPED_TRACE(lock ? "bonded rotation locked" : "bonded rotation free");
+    auto make = [&] {
+      WorldSettings ws;
+      ws.lock_bonded_rotation = lock;
+      World w = test::random_box(400, ws);
+      for (std::int64_t id = 0; id < std::int64_t(w.particle_count()); ++id)
+        w.set_angular_velocity(id, {0, 0, 0});
+      return w;
+    };
+    World a = make(), b = make();
+    std::vector<std::int64_t> even;
+    for (std::int64_t id = 0; id < std::int64_t(a.particle_count()); id += 2) even.push_back(id);
+    BondMaterial bm;
+    bm.breakable = false;
+    int still = 0, turning = 0, bonds_still = 0, bonds_turning = 0;
+    for (int k = 0; k < 800; ++k) {
+      if (k == 400)
+        for (World* w : {&a, &b}) ASSERT_GT(w->install_bonds(bm, 1e-4, even), 50u);
+      b.state().spin_known = false;  // the twin scans
+      a.cycle(1);
+      b.cycle(1);
+      const auto& s = a.state();
+      ASSERT_TRUE(s.spin_known);
+      (s.spin_reachable == 0 ? still : turning) += 1;
+      if (k >= 400) (s.spin_bonded == 0 ? bonds_still : bonds_turning) += s.spin_reachable != 0;
+    }
+    EXPECT_GT(still, 0) << "the run starts without spin";
+    EXPECT_GT(turning, 0) << "and the contacts make the spheres turn";
+    if (lock)
+      EXPECT_EQ(bonds_turning, 0) << "the bonded spheres do not turn while the others do";
+    else
+      EXPECT_GT(bonds_turning, 0) << "the bonded spheres turn";
+    EXPECT_GT(bonds_still + bonds_turning, 0);
+    EXPECT_GT(a.contact_count(), 50u) << "unbonded contacts";
+    expect_same_run(a, b);
+  }
+}
+
+// Two layers of spheres that may not turn (rotation locked) in a box, under a layer made a rigid
+// group turning at a set angular velocity: only the group's members spin, given their group's angular velocity by the group
+// stages after the gather. The next pair stage must see it.
+TEST(Determinism, SpinOfRigidGroupMembersReachesThePairStage) {
+  constexpr int n = 8;
+  constexpr double d = 1e-3, a = 0.99 * d;
+  auto make = [&] {
+    World w;
+    std::vector<double> xyz;
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i)
+          for (double c : {(i + 0.5) * a, (j + 0.5) * a, (k + 0.5) * a}) xyz.push_back(c);
+    w.add_particles(xyz, std::vector<double>(xyz.size() / 3, 0.5 * d));
+    const double L = n * a;  // a box of five planes keeps the lattice's 1 % overlaps
+    w.add_plane({0, 0, 0}, {0, 0, 1});
+    w.add_plane({0, 0, 0}, {1, 0, 0});
+    w.add_plane({L, 0, 0}, {-1, 0, 0});
+    w.add_plane({0, 0, 0}, {0, 1, 0});
+    w.add_plane({0, L, 0}, {0, -1, 0});
+    std::vector<std::int64_t> top;
+    for (std::int64_t id = 0; id < std::int64_t(w.particle_count()); ++id) {
+      if (id >= 2 * n * n) top.push_back(id);
+      else w.set_rotation_locked(id, true);
+    }
+    GroupMotion turn;
+    turn.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
+    turn.rotation = Dof::velocity;
+    turn.angular_velocity = {2e-2, 0, 0};
+    w.add_group(top, turn);
+    return w;
+  };
+  World x = make(), y = make();
+  for (int k = 0; k < 300; ++k) {
+    y.state().spin_known = false;
+    x.cycle(1);
+    y.cycle(1);
+  }
+  ASSERT_TRUE(x.state().spin_known);
+  EXPECT_NE(x.state().spin_reachable, 0u) << "the members spin";
+  EXPECT_GT(x.contact_count(), 100u);
+  expect_same_run(x, y);
+}
