@@ -850,8 +850,9 @@ TEST(Determinism, SpinTakenFromTheLastStepEqualsAScanEveryStep) {
     bm.breakable = false;
     int still = 0, turning = 0, bonds_still = 0, bonds_turning = 0;
     for (int k = 0; k < 800; ++k) {
-      if (k == 400)
+      if (k == 400) {
         for (World* w : {&a, &b}) ASSERT_GT(w->install_bonds(bm, 1e-4, even), 50u);
+      }
       b.state().spin_known = false;  // the twin scans
       a.cycle(1);
       b.cycle(1);
@@ -862,10 +863,11 @@ TEST(Determinism, SpinTakenFromTheLastStepEqualsAScanEveryStep) {
     }
     EXPECT_GT(still, 0) << "the run starts without spin";
     EXPECT_GT(turning, 0) << "and the contacts make the spheres turn";
-    if (lock)
+    if (lock) {
       EXPECT_EQ(bonds_turning, 0) << "the bonded spheres do not turn while the others do";
-    else
+    } else {
       EXPECT_GT(bonds_turning, 0) << "the bonded spheres turn";
+    }
     EXPECT_GT(bonds_still + bonds_turning, 0);
     EXPECT_GT(a.contact_count(), 50u) << "unbonded contacts";
     expect_same_run(a, b);
