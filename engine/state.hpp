@@ -133,7 +133,6 @@ struct State {
   // the particles, serially, every step (on two threads the scans were ~5 % of the joint's step).
   bool spin_known = false;
   std::uint64_t spin_reachable = 0, spin_bonded = 0;
-  bool spin_scan_full = false;  // this step's gather + integrate stage took every block's ORs
   // Every bond's beam moments are +-0 (set by a scan in refresh_bond_topology, cleared by a bond
   // stage that runs with spin): only spin makes them grow, so the bond stage may take the kernel
   // that neither carries nor stores them (kernels/bonds.cpp).

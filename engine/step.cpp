@@ -66,10 +66,10 @@ void bookkeep(State& s) {
   // What spins now (State::spin_known): the blocks' ORs, taken after each block moved, and the
   // moved group members, which took their group's new angular velocity after them (move_members).
   // A step that started from a known answer adds to it (integrate.cpp: only its blocks with
-  // rotation were read).
+  // rotation were read); one that did not took every block's and starts it afresh.
   if (!s.any_rotating) {
     s.spin_known = false;  // the blocks took no ORs
-  } else if (s.spin_scan_full || s.spin_known) {
+  } else {
     std::uint64_t reachable = 0, bonded = 0;
     for (const auto& r : s.particle_blocks) {
       reachable |= r.spin_reachable;
@@ -82,7 +82,7 @@ void bookkeep(State& s) {
           members |= std::bit_cast<std::uint64_t>(gs.angular_velocity.x) |
                      std::bit_cast<std::uint64_t>(gs.angular_velocity.y) |
                      std::bit_cast<std::uint64_t>(gs.angular_velocity.z);
-    if (s.spin_scan_full) s.spin_reachable = s.spin_bonded = 0;
+    if (!s.spin_known) s.spin_reachable = s.spin_bonded = 0;
     s.spin_reachable |= reachable | members;
     s.spin_bonded |= bonded | members;
     s.spin_known = true;

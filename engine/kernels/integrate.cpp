@@ -13,7 +13,6 @@
 // gather kernels (gather_loop.hpp) read as 256-bit vectors; the wall and applied terms follow in
 // scalar passes. The operations are those the scalar gather did (so the results are bitwise the
 // same).
-#include <bit>
 #include <cmath>
 
 #include "state.hpp"
@@ -111,18 +110,14 @@ StageLoop integrate_stage(State& s) {
   // integrated can add to it: the kernel without rotation and the gather write no w, the group
   // stages give members their group's (bookkeep adds it). Once something spins the answer cannot
   // change until it is cleared, so nothing is read then (the lattice, where both say so).
-  const double *wx = p.wx.data(), *wy = p.wy.data(), *wz = p.wz.data();
+  const ParticleStore* const ps = &p;
   const std::int32_t* bond_start = binc.start.size() > n ? binc.start.data() : nullptr;
-  const bool full = !s.spin_known;
-  s.spin_scan_full = full;
+  const bool full = !s.spin_known;  // bookkeep starts the answer afresh then
   const bool track =
       s.any_rotating && (full || s.spin_reachable == 0 || (bq.n > 0 && s.spin_bonded == 0));
   auto spin_of = [=](std::size_t first, std::size_t end, ParticleBlockResult& r) {
     // Branch-free (all-ones masks), so that the loops vectorise.
-    auto bits = [=](std::size_t i) {
-      return std::bit_cast<std::uint64_t>(wx[i]) | std::bit_cast<std::uint64_t>(wy[i]) |
-             std::bit_cast<std::uint64_t>(wz[i]);
-    };
+    auto bits = [=](std::size_t i) { return ps->spin_bits(i); };
     auto is_inert = [=](std::size_t i) { return std::uint64_t(0) - std::uint64_t(inert[i] != 0); };
     std::uint64_t reachable = 0, bonded = 0;
     if (bond_start) {

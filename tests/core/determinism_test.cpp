@@ -22,6 +22,13 @@
 
 using namespace asperity;
 
+namespace {
+// The same length and the same bits (a NaN equals itself, +0 differs from -0).
+bool same(const std::vector<double>& u, const std::vector<double>& v) {
+  return u.size() == v.size() && std::memcmp(u.data(), v.data(), u.size() * sizeof(double)) == 0;
+}
+}  // namespace
+
 TEST(Determinism, FullStateBitwiseIdenticalWithOneAndTwoThreads) {
   WorldSettings one, two;
   one.threads = 1;
@@ -30,9 +37,6 @@ TEST(Determinism, FullStateBitwiseIdenticalWithOneAndTwoThreads) {
   a.cycle(1500);
   b.cycle(1500);
   ASSERT_GT(a.contact_count(), 500u) << "the scene must be busy";
-  auto same = [](const std::vector<double>& u, const std::vector<double>& v) {
-    return u.size() == v.size() && std::memcmp(u.data(), v.data(), u.size() * sizeof(double)) == 0;
-  };
   EXPECT_TRUE(same(a.positions(), b.positions()));
   EXPECT_TRUE(same(a.velocities(), b.velocities()));
   EXPECT_TRUE(same(a.forces(), b.forces()));
@@ -90,9 +94,6 @@ TEST(Determinism, PlatensMovedInTheParallelRegionAreTheSameOnOneAndTwoThreads) {
   ASSERT_GE(2u * n * n, 512u);
   ASSERT_GT(one.group_position(top1).x - start.x, 0.0);
   ASSERT_GT(one.group_force(top1).z, 0.0);
-  auto same = [](const std::vector<double>& u, const std::vector<double>& v) {
-    return u.size() == v.size() && std::memcmp(u.data(), v.data(), u.size() * sizeof(double)) == 0;
-  };
   EXPECT_TRUE(same(one.positions(), two.positions()));
   EXPECT_TRUE(same(one.velocities(), two.velocities()));
   EXPECT_TRUE(same(one.forces(), two.forces()));
@@ -815,9 +816,6 @@ std::vector<double> angular_velocities(const World& w) {
 }
 
 void expect_same_run(const World& a, const World& b) {
-  auto same = [](const std::vector<double>& u, const std::vector<double>& v) {
-    return u.size() == v.size() && std::memcmp(u.data(), v.data(), u.size() * sizeof(double)) == 0;
-  };
   EXPECT_TRUE(same(a.positions(), b.positions()));
   EXPECT_TRUE(same(a.velocities(), b.velocities()));
   EXPECT_TRUE(same(angular_velocities(a), angular_velocities(b)));
