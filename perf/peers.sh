@@ -114,9 +114,12 @@ run_engine() {  # engine cores log
   esac
 }
 
+# The commit is read once, before the first row is appended: the appended CSV itself would mark the
+# tree dirty for every later row.
+commit=$(git -C "$repo" describe --always --dirty 2>/dev/null || echo unknown)
 engine_version() {
   case $1 in
-    asperity) echo "$(git -C "$repo" describe --always --dirty 2>/dev/null || echo unknown)" ;;
+    asperity) echo "$commit" ;;
     lammps)   dpkg-query -W -f '${Version}' lammps 2>/dev/null || echo unknown ;;
     liggghts) dpkg-query -W -f '${Version}' liggghts 2>/dev/null || echo unknown ;;
     yade)     dpkg-query -W -f '${Version}' yade 2>/dev/null || echo unknown ;;
@@ -222,7 +225,6 @@ mkdir -p "$here/results"
 slug=$(echo "$cpu" | tr 'A-Z' 'a-z' | sed -e 's/([a-z]*)//g' -e 's/[^a-z0-9]\+/-/g' -e 's/^-//' -e 's/-$//')
 csv=$here/results/${slug:-$(hostname)}.csv
 [[ -s $csv ]] || echo "date,cpu_model,simd,commit,engine,engine_version,cores,n,particles,steps,particle_steps_per_s,load_avg,particle_steps_per_cpu_s" >"$csv"
-commit=$(git -C "$repo" describe --always --dirty 2>/dev/null || echo unknown)
 now=$(date -u +%Y-%m-%dT%H:%M:%SZ)
 load=$(cut -d' ' -f1 /proc/loadavg)
 for e in $ENGINES; do
