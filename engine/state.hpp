@@ -268,6 +268,14 @@ struct GroupStages {
 };
 GroupStages group_stages(State& s);     // bodies/groups.cpp; empty stages without groups
 double estimate_critical_dt(const State& s);  // step.cpp
+// The deepest contact overlap relative to the radius of the smaller body it joins (a wall counts
+// as infinitely large), over touching pairs, wall contacts and bonds; particle -1 and ratio 0
+// when nothing overlaps (step.cpp).
+struct OverlapRatio {
+  double ratio = 0;
+  std::int64_t particle = -1;
+};
+OverlapRatio deepest_overlap(const State& s);
 Energies compute_energies(const State& s);    // step.cpp
 void step_once(State& s);               // step.cpp
 void watch_load(State& s);              // step.cpp: State::load_limit, for automatic threads

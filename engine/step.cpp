@@ -158,28 +158,32 @@ void check_energy(State& s) {
 // (nearly) inside the other particle, where the linear contact law [3-5] and the contact point
 // [3-11] mean nothing. Checked every dt_interval steps with the time-step estimate.
 void check_overlaps(State& s) {
-  const ParticleStore& p = s.p;
-  double worst = 0;
-  std::int64_t worst_i = -1;
-  for (std::size_t k = 0; k < s.pairs.n; ++k) {
-    const double U = s.pairs.overlap_at(k);
-    if (!(U > 0)) continue;
-    const auto a = s.pairs.a[k], b = s.pairs.b[k];
-    const double r = U / std::min(p.radius[a], p.radius[b]);
-    if (r > worst) worst = r, worst_i = p.radius[a] <= p.radius[b] ? a : b;
-  }
-  const WallContacts& wc = s.walls.contacts;
-  for (std::size_t k = 0; k < wc.n; ++k) {
-    const double r = wc.overlap[k] / p.radius[wc.particle[k]];
-    if (r > worst) worst = r, worst_i = wc.particle[k];
-  }
-  if (worst > 1.0)
+  const OverlapRatio worst = deepest_overlap(s);
+  if (worst.ratio > 1.0)
     health_error(s, "a contact overlap exceeds the particle's radius: the contacts are too soft for "
                     "the load (raise kn, or lower the load or the loading rate)",
-                 worst_i, "overlap / R", worst);
+                 worst.particle, "overlap / R", worst.ratio);
 }
 
 }  // namespace
+
+OverlapRatio deepest_overlap(const State& s) {
+  const ParticleStore& p = s.p;
+  OverlapRatio worst;
+  auto consider = [&](double U, std::int64_t a, std::int64_t b) {
+    if (!(U > 0)) return;
+    const std::int64_t smaller = b < 0 || p.radius[a] <= p.radius[b] ? a : b;
+    const double r = U / p.radius[smaller];
+    if (r > worst.ratio) worst.ratio = r, worst.particle = smaller;
+  };
+  for (std::size_t k = 0; k < s.pairs.n; ++k) consider(s.pairs.overlap_at(k), s.pairs.a[k], s.pairs.b[k]);
+  const WallContacts& wc = s.walls.contacts;
+  for (std::size_t k = 0; k < wc.n; ++k) consider(wc.overlap[k], wc.particle[k], -1);
+  // A bond's contact spring is a contact too: a bonded pair pressed a radius deep is as
+  // meaningless (broken bonds leave the store in process_breaks).
+  for_each_bond(s, [&](const BondStore& q, std::size_t k) { consider(q.overlap[k], q.a[k], q.b[k]); });
+  return worst;
+}
 
 double estimate_critical_dt(const State& s) {
   // [3-30..3-32]: per body and degree of freedom sqrt(m / k_tran), sqrt(I / k_rot), with the

@@ -852,6 +852,8 @@ std::vector<ContactInfo> World::contacts() const {
   return out;
 }
 
+double World::max_overlap_ratio() const { return detail::deepest_overlap(*state_).ratio; }
+
 std::size_t World::contact_count() const {
   const auto& q = state_->pairs;
   std::size_t c = 0;

@@ -42,6 +42,8 @@ local P = require("params").defaults{
   velocity = 1.5e-5,       -- shear velocity, m/s (perf/runtime_vs_error.lua: within 1 % of a 2x slower run)
   ramp = 0.05,             -- mm over which the shear velocity rises linearly from 0 (no start-up impact)
   quasi_static_limit = 0.01, -- warn when the kinetic energy exceeds this x normal load x mean radius
+  overlap_limit = 0.5,     -- warn when a contact overlaps this fraction of the smaller radius (the engine
+                           -- stops at 1): the contacts are too soft for the load (perf/README.md)
   normal_control = "servo", -- servo (model.md 7, with integral action) or load: a constant force on a free platen
   platen_damping = 0,      -- local damping of the dead-load platen (< 0: the world's)
   servo_relaxation = 0.4,  -- servo gain: fraction of the force error the platen contacts correct per step
@@ -402,7 +404,17 @@ local function platen_force()
   return {f[1], f[2], f[3] - applied_z}
 end
 local function normal_stress() return platen_force()[3] / area end
+-- The deepest overlap of any contact or bond over the smaller radius, read at every record. The
+-- soft model (model.md 9) keeps overlaps small at the study's loads; deep ones mean the contacts
+-- are too soft for the load, and the contact points and lever arms [3-11] lose their sense long
+-- before the engine's health check stops the run at one radius.
+local overlap_max, overlap_at = 0, "closure"
+local function track_overlap(where)
+  local r = world:max_overlap_ratio()
+  if r > overlap_max then overlap_max, overlap_at = r, where end
+end
 local function record_closure()
+  track_overlap("closure")
   local s = normal_stress()
   local c = between()
   local d = z_contact - world:group_position(top)[3]
@@ -512,6 +524,7 @@ local function record_shear()
   local tau = f[axis] / area   -- the lower half resists the upper one moving along -axis
   local e = world:energies()
   if e.kinetic / energy_scale > dynamic_ratio then dynamic_ratio, dynamic_at = e.kinetic / energy_scale, displacement() end
+  track_overlap(("%.3f mm of shear"):format(displacement()))
   shear_impulse[#shear_impulse + 1] = impulse[axis]
   shear:record(displacement(), tau, mpa(tau), mpa(f[3] / area), mpa(sn_mean), (p[3] - c0[3]) * 1e3, c.count,
                100 * c.area / area, world:break_count(), mpa(c.flagged_force[axis] / area),
@@ -592,6 +605,11 @@ if dynamic_ratio > P.quasi_static_limit then
       .. "(limit quasi_static_limit = %g); results depend on the loading rate: lower velocity (now %g m/s)",
       dynamic_ratio, dynamic_at, P.quasi_static_limit, P.velocity)
 end
+if overlap_max > P.overlap_limit then
+  log("WARNING: a contact overlapped %.3g of its smaller radius (%s; limit overlap_limit = %g): the contacts "
+      .. "are too soft for the load, and contact points and lever arms lose their sense; lower the normal "
+      .. "stress (now %g MPa)", overlap_max, overlap_at, P.overlap_limit, P.stress)
+end
 -- Initial shear stiffness: slope over the first 30 % of the peak stress.
 local sx, sy = {}, {}
 for k = 1, at do if tau[k] <= 0.3 * peak then sx[#sx + 1] = u[k]; sy[#sy + 1] = tau[k] end end
@@ -644,6 +662,9 @@ local summary = {
   kinetic_ratio_max = dynamic_ratio,         -- max Ek / (normal load x mean radius) while shearing
   kinetic_ratio_max_at_mm = dynamic_at,
   quasi_static = dynamic_ratio <= P.quasi_static_limit,
+  overlap_ratio_max = overlap_max,           -- deepest overlap / smaller radius, over every record
+  overlap_ratio_max_at = overlap_at,
+  overlaps_small = overlap_max <= P.overlap_limit,
   initial_shear_stiffness_mpa_per_mm = ks,
   max_dilatancy_mm = max_dil,
   dilatancy_angle_at_peak_deg = math.deg(math.atan(slope_at(at))),

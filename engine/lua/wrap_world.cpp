@@ -1163,6 +1163,10 @@ int world_contacts(lua_State* L) {
   });
 }
 
+int world_max_overlap_ratio(lua_State* L) {
+  return guarded(L, [&] { lua_pushnumber(L, world_arg(L).max_overlap_ratio()); return 1; });
+}
+
 int world_contact_count(lua_State* L) {
   return guarded(L, [&] {
     lua_pushinteger(L, static_cast<lua_Integer>(world_arg(L).contact_count()));
@@ -1332,6 +1336,9 @@ void open_world(lua_State* L) {
       {"contacts", world_contacts, "world:contacts() -> {contact, ...}",
        "Touching ball-ball pairs: {a, b, normal, point, overlap, normal_force, shear_force}."},
       {"contact_count", world_contact_count, "world:contact_count() -> n", "Touching ball-ball pairs."},
+      {"max_overlap_ratio", world_max_overlap_ratio, "world:max_overlap_ratio() -> r",
+       "Deepest overlap (touching pairs, wall contacts, bonds) / radius of the smaller body; 0 if none.\n"
+       "A step past 1 stops with a health error; well before, the contacts are soft for the load."},
       {"settings", world_settings, "world:settings() -> table", "The settings the world was made with."},
   };
   static const luaL_Reg meta[] = {{"__gc", world_gc}, {"__tostring", world_tostring}};

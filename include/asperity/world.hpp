@@ -301,6 +301,10 @@ class World {
   double unbalanced_force_ratio() const;
   std::vector<ContactInfo> contacts() const;  // touching ball-ball pairs
   std::size_t contact_count() const;
+  // The deepest overlap of a touching pair, wall contact or bond over the radius of the smaller
+  // body (a wall's contact: the particle's); 0 when nothing overlaps. A step stops with a
+  // HealthError past 1; well before that the soft contacts of model.md 9 are soft for the load.
+  double max_overlap_ratio() const;
 
   // --- checkpoints ---------------------------------------------------------------------------
   // The whole state in one HDF5 file (written to a temporary name, then renamed); a world loaded

@@ -166,3 +166,34 @@ TEST(Health, AnOverlapDeeperThanTheRadiusIsReported) {
     EXPECT_NE(std::string(e.what()).find("too soft"), std::string::npos);
   }
 }
+
+// The measure behind that check, which scripts read to warn well before it fires: overlap over
+// the radius of the smaller body, for a pair, a wall contact and a bond, each the deepest in turn.
+// Overlaps are outputs of a step (as contact_count): each is read after one step so short that
+// nothing moves measurably.
+TEST(Health, MaxOverlapRatioIsTheDeepestOverlapOverTheSmallerRadius) {
+  WorldSettings ws;
+  ws.rotation = false;
+  ws.dt = 1e-12;
+  World w(ws);
+  EXPECT_EQ(w.max_overlap_ratio(), 0.0) << "an empty world";
+  // Pair: radii 1 and 0.5 mm, centres 1.4 mm apart: U = 0.1 mm, over the smaller radius 0.2.
+  w.add_particle({0, 0, 0}, 1e-3);
+  w.add_particle({1.4e-3, 0, 0}, 0.5e-3);
+  w.cycle(1);
+  EXPECT_NEAR(w.max_overlap_ratio(), 0.2, 1e-9);
+  // A wall contact 0.3 of its particle's radius deep is deeper.
+  w.add_plane({0, 0, -5e-3}, {0, 0, 1});
+  w.add_particle({0, 5e-3, -4.3e-3}, 1e-3);
+  w.cycle(1);
+  EXPECT_NEAR(w.max_overlap_ratio(), 0.3, 1e-9);
+  // A bonded pair pressed 0.45 of the smaller radius: bonds count as contacts.
+  const auto c = w.add_particle({0, 10e-3, 2e-3}, 1e-3);
+  const auto d = w.add_particle({0, 10e-3 + 1.55e-3, 2e-3}, 1e-3);
+  const std::vector<std::int64_t> cd{c, d};
+  BondMaterial bm;
+  bm.breakable = false;
+  EXPECT_EQ(w.install_bonds(bm, -1, cd), 1u);
+  w.cycle(1);
+  EXPECT_NEAR(w.max_overlap_ratio(), 0.45, 1e-9);
+}

@@ -38,6 +38,11 @@ for _, key in ipairs{"peak_shear_stress_mpa", "peak_displacement_mm", "residual_
   assert(el[key] == el[key] and el[key] ~= nil, "summary." .. key .. " is a number")
 end
 assert(el.peak_shear_stress_mpa > 0 and el.normal_stiffness_mpa_per_mm > 0)
+-- The deepest overlap over the records: some contact is loaded, none a radius deep (the engine
+-- would have stopped), and the flag says whether it stayed under the warning's limit.
+assert(el.overlap_ratio_max > 0 and el.overlap_ratio_max < 1,
+       ("overlap_ratio_max %.3g not in (0, 1)"):format(el.overlap_ratio_max))
+assert(el.overlaps_small == (el.overlap_ratio_max <= el.parameters.overlap_limit), "overlaps_small follows the limit")
 
 -- The same joint with the force laws in single precision (simd=float, perf/runtime_vs_error.lua's
 -- study): it runs those kernels, and at this size lands within a few per cent of double.
