@@ -197,3 +197,72 @@ TEST(Health, MaxOverlapRatioIsTheDeepestOverlapOverTheSmallerRadius) {
   w.cycle(1);
   EXPECT_NEAR(w.max_overlap_ratio(), 0.45, 1e-9);
 }
+
+// Dimensional consistency of the whole step. In the linear model, multiplying every stiffness
+// (contacts, walls, beams) by 4, gravity and bond strength by 4 (accelerations, stresses), and
+// the prescribed velocities by 2 while halving dt is the same motion at twice the speed: forces
+// x4, velocities x2, the same positions step by step. Every factor is a power of two, so the
+// correspondence is exact in floating point too (sqrt(4x) = 2 sqrt(x), and so on): the positions
+// must agree bit for bit. A term of the law, damping, integration, break criterion or wall
+// motion that missed a dt, a stiffness or a velocity would break it. This is why the run-time
+// study (perf/runtime_vs_error.lua) treats stiff or soft contacts as its velocity axis.
+TEST(Scaling, StiffnessTimesFourIsTheSameMotionAtTwiceTheSpeed) {
+  auto build = [](double f) {
+    WorldSettings ws;
+    ws.contact.kn = 0.1 * f;
+    ws.contact.ks = 0.03 * f;
+    ws.contact.friction = 0.4;
+    ws.lock_bonded_rotation = false;  // bonded spin and beam moments take part too
+    ws.gravity = {0, 0, -9.81 * f};
+    World w(ws);
+    ContactMaterial wall;
+    wall.kn = 0.2 * f;
+    wall.ks = 0.05 * f;
+    wall.friction = 0.3;
+    // 4 x 4 x 4 spheres of radius 0.9-1.1 mm on a jittered lattice, slightly overlapping, between
+    // a floor and a lid that comes down.
+    const double R = 1e-3, a = 1.98e-3;
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        for (int k = 0; k < 4; ++k)
+          w.add_particle({i * a + 0.02 * R * u(rng), j * a + 0.02 * R * u(rng), R + k * a + 0.02 * R * u(rng)},
+                         R * (1 + 0.1 * u(rng)));
+    w.add_plane({0, 0, 0}, {0, 0, 1}, wall);
+    const int lid = w.add_plane({0, 0, 4 * a}, {0, 0, -1}, wall);
+    w.set_wall_velocity(lid, {0, 0, -0.05 * std::sqrt(f)});
+    BondMaterial bm;
+    bm.beam_kn = 0.1 * f;
+    bm.beam_ks = 0.02 * f;
+    bm.tensile_strength = 2.0 * f;  // Pa: low enough that some bonds break under the lid
+    w.install_bonds(bm);
+    w.set_dt(2e-5 / std::sqrt(f));
+    return w;
+  };
+  World slow = build(1), fast = build(4);
+  std::size_t breaks = 0;
+  for (int chunk = 0; chunk < 30; ++chunk) {
+    slow.cycle(100);
+    fast.cycle(100);
+    for (std::int64_t id = 0; id < std::int64_t(slow.particle_count()); ++id) {
+      const Vec3 xs = slow.position(id), xf = fast.position(id);
+      ASSERT_TRUE(xs.x == xf.x && xs.y == xf.y && xs.z == xf.z)
+          << "particle " << id << " after " << slow.step_count() << " steps";
+      const Vec3 vs = slow.velocity(id), vf = fast.velocity(id);
+      ASSERT_TRUE(2 * vs.x == vf.x && 2 * vs.y == vf.y && 2 * vs.z == vf.z) << "velocity x2, particle " << id;
+      const Vec3 fs = slow.force(id), ff = fast.force(id);
+      ASSERT_TRUE(4 * fs.x == ff.x && 4 * fs.y == ff.y && 4 * fs.z == ff.z) << "force x4, particle " << id;
+    }
+    breaks = slow.break_events().size();
+    ASSERT_EQ(fast.break_events().size(), breaks);
+  }
+  EXPECT_GT(slow.contact_count() + slow.bond_count(), 50u) << "a loaded packing, not free flight";
+  const Energies es = slow.energies(), ef = fast.energies();
+  EXPECT_EQ(4 * es.kinetic, ef.kinetic);
+  EXPECT_EQ(4 * es.strain, ef.strain);
+  EXPECT_EQ(4 * es.friction, ef.friction);
+  EXPECT_EQ(4 * es.damping, ef.damping);
+  std::printf("scaling: %zu bonds broken, %zu bonds and %zu contacts left, friction %.3g J\n", breaks,
+              slow.bond_count(), slow.contact_count(), es.friction);
+}
