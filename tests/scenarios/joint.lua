@@ -46,8 +46,12 @@ assert(el.overlaps_small == (el.overlap_ratio_max <= el.parameters.overlap_limit
 
 -- The same joint with the force laws in single precision (simd=float, perf/runtime_vs_error.lua's
 -- study): it runs those kernels, and at this size lands within a few per cent of double.
-local fl = joint{surface = "S1", model = "elastic", simd = "float", out = out .. "/S1_elastic_float"}
+-- Its overlap limit is set below what the joint reaches, so it must say that it was crossed.
+local fl = joint{surface = "S1", model = "elastic", simd = "float", overlap_limit = 0.05,
+                 out = out .. "/S1_elastic_float"}
 assert(fl.kernels == "float" and el.kernels ~= "float", "simd=float selects the float kernels for the test")
+assert(fl.overlap_ratio_max > 0.05 and fl.overlaps_small == false,
+       ("overlap_limit 0.05: overlap_ratio_max %.3g, overlaps_small %s"):format(fl.overlap_ratio_max, tostring(fl.overlaps_small)))
 for _, key in ipairs{"peak_shear_stress_mpa", "residual_shear_stress_mpa", "max_dilatancy_mm"} do
   local rel = math.abs(fl[key] / el[key] - 1)
   assert(rel < 0.05, ("float: %s %.5g against double %.5g (%.2g)"):format(key, fl[key], el[key], rel))
