@@ -87,6 +87,9 @@ end
 local models = {rigid = true, elastic = true, fracture = true}
 if not models[P.model] then error("model must be rigid, elastic or fracture, got '" .. P.model .. "'") end
 if P.direction ~= "x" and P.direction ~= "y" then error("direction must be x or y") end
+for _, key in ipairs{"quasi_static_limit", "overlap_limit"} do
+  if not (P[key] > 0) then error(("%s must be > 0, got %s"):format(key, tostring(P[key]))) end
+end
 local t_start = asperity.wall_time()
 asperity.mkdir(P.out)
 asperity.mkdir(P.cache)
@@ -404,10 +407,11 @@ local function platen_force()
   return {f[1], f[2], f[3] - applied_z}
 end
 local function normal_stress() return platen_force()[3] / area end
--- The deepest overlap of any contact or bond over the smaller radius, read at every record. The
--- soft model (model.md 9) keeps overlaps small at the study's loads; deep ones mean the contacts
--- are too soft for the load, and the contact points and lever arms [3-11] lose their sense long
--- before the engine's health check stops the run at one radius.
+-- The deepest overlap of any contact or bond over the smaller radius, read at every record. At the
+-- study's loads single asperity contacts are pressed 0.3-0.45 of a radius deep (perf/README.md,
+-- "Contacts soft for the load"); deeper ones mean the contacts are too soft for the load, and the
+-- contact points and lever arms [3-11] lose their sense long before the engine's health check
+-- stops the run at one radius.
 local overlap_max, overlap_at = 0, "closure"
 local function track_overlap(where)
   local r = world:max_overlap_ratio()
