@@ -523,7 +523,6 @@ void World::set_inert(std::span<const std::int64_t> ids, bool inert) {
     idx.push_back(i);
   }
   for (auto i : idx) s.p.inert[i] = inert ? 1 : 0;
-  s.spin_known = false;  // a particle a pair can reach now may spin
   for (auto& g : s.groups) {
     std::vector<std::int32_t> all(g.members);
     all.insert(all.end(), g.inert.begin(), g.inert.end());
