@@ -126,9 +126,16 @@ void bookkeep(State& s) {
   // bodies have closed `skin` between them, which the two largest displacements of distinct bodies
   // bound (a free particle is a body of its own: two free particles count the free maximum twice,
   // the classic skin/2 rule; two rigid bodies of which one stands still may move a whole skin). A
-  // wall contact likewise needs the particle and the wall to close `skin`.
+  // wall contact likewise needs the particle and the wall to close `skin`, or skin/2 for the
+  // free particles of a mesh that listed them within R + skin/2 (Wall::candidates_within_half_
+  // skin; while the mesh stands still the pair rule already keeps free particles within skin/2).
+  const double free_move = max_disp2 > 0 ? std::sqrt(max_disp2) : 0.0;
   double wall_move = 0;
-  for (const auto& w : s.walls.walls) wall_move = std::max(wall_move, norm(w.displacement - w.displacement_at_build));
+  for (const auto& w : s.walls.walls) {
+    const double move = norm(w.displacement - w.displacement_at_build);
+    wall_move = std::max(wall_move, move);
+    if (w.candidates_within_half_skin && !(free_move + move <= 0.5 * s.skin)) s.need_rebuild = true;
+  }
   if (!(first + second <= s.skin) || !(first + wall_move <= s.skin)) s.need_rebuild = true;
 }
 

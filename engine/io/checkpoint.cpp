@@ -21,8 +21,9 @@ namespace asperity {
 namespace {
 
 using detail::State;
-constexpr int kCheckpointVersion = 3;  // 2: servo integral and integral time, group damping;
-                                       // 3: rest overlaps (stress-free bonds)
+constexpr int kCheckpointVersion = 4;  // 2: servo integral and integral time, group damping;
+                                       // 3: rest overlaps (stress-free bonds);
+                                       // 4: meshes' candidates within half the skin
 
 template <class T>
 hid_t native_type() {
@@ -297,6 +298,8 @@ void visit(Io& io, State& s) {
     io.vec(at + "/displacement_at_build", wall.displacement_at_build);
     io.vec(at + "/force", wall.force);
     io.flag(at + "/removed", wall.removed);
+    // Older files listed every candidate within the whole skin: false, which is what they hold.
+    if (io.version >= 4) io.flag(at + "/candidates_within_half_skin", wall.candidates_within_half_skin);
   }
   io.count("meshes/n", s.walls.meshes);
   for (std::size_t m = 0; m < s.walls.meshes.size(); ++m) {

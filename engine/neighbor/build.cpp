@@ -391,6 +391,9 @@ void build_wall_contacts(State& s) {
     double distance;  // centre to the triangle (mesh); 0 for a plane
   };
   std::vector<std::vector<Candidate>> cand(n);  // per particle
+  for (Wall& wall : walls)
+    wall.candidates_within_half_skin =
+        wall.kind == Wall::Kind::mesh && !wall.removed && wall.velocity == Vec3{0, 0, 0};
 #pragma omp parallel num_threads(thread_count(s))
   {
     std::vector<std::int32_t> tris;
@@ -399,6 +402,11 @@ void build_wall_contacts(State& s) {
       if (p.inert[i]) continue;
       const Vec3 c{p.x[i], p.y[i], p.z[i]};
       const double reach = p.radius[i] + s.skin;
+      // A free particle's triangles of a still mesh within R + skin/2 (Wall::candidates_within_
+      // half_skin): one farther away stays farther than R while the particle and the wall close at
+      // most skin/2 (the rebuild rule), so the wall stage would skip it at every step until the
+      // next build (kernels/walls.cpp, the same rounding margin). Dropping it changes no bit.
+      const double near_reach = (p.radius[i] + 0.5 * s.skin) * (1 + 1e-9);
       for (std::size_t w = 0; w < walls.size(); ++w) {
         const Wall& wall = walls[w];
         if (wall.removed) continue;
@@ -408,7 +416,8 @@ void build_wall_contacts(State& s) {
         } else {
           const Mesh& mesh = s.walls.meshes[wall.mesh];
           const Vec3 q = c - wall.displacement;
-          query_mesh(mesh, q, reach, tris);
+          const double r = wall.candidates_within_half_skin && p.group[i] < 0 ? near_reach : reach;
+          query_mesh(mesh, q, r, tris);
           for (std::int32_t t : tris) {
             const auto& tri = mesh.triangles[t];
             int feature;
@@ -416,7 +425,7 @@ void build_wall_contacts(State& s) {
                                                       mesh.vertices[tri[1]],
                                                       mesh.vertices[tri[2]], feature);
             const Vec3 d = q - cp;
-            if (dot(d, d) < reach * reach) cand[i].push_back({std::int32_t(w), t, norm(d)});
+            if (dot(d, d) < r * r) cand[i].push_back({std::int32_t(w), t, norm(d)});
           }
         }
       }

@@ -33,6 +33,16 @@ struct Mesh {
   // edge is the contact, and this one is its shadow).
   std::vector<std::int32_t> vertex_start, vertex_triangles;
   TriangleBins bins;
+
+  // Its arrays past the caches (4 MB, as records_past_caches in state.hpp): a thesis-scale mould
+  // of 365 x 365 nodes holds ~10 MB, the 2 cm one ~0.4 MB. The wall stage then prefetches the
+  // triangles of the contacts it will evaluate, which cost 0.93 of the packing step at thesis
+  // scale and would cost 1.17 in cache (kernels/walls.cpp, perf/README.md).
+  bool past_caches() const {
+    const std::size_t bytes = vertices.size() * sizeof(Vec3) + triangles.size() * sizeof(triangles[0]) +
+                              owns.size() + (vertex_start.size() + vertex_triangles.size()) * sizeof(std::int32_t);
+    return bytes > (std::size_t(4) << 20);
+  }
 };
 
 struct Wall {
@@ -45,6 +55,11 @@ struct Wall {
   Vec3 displacement_at_build{0, 0, 0};
   Vec3 force{0, 0, 0};                 // of the particles on the wall, last step
   bool removed = false;
+  // A mesh standing still at the last neighbour build lists a free particle's triangles only
+  // within R + skin/2, not R + skin (neighbor/build.cpp): about half of a mould's candidates,
+  // which its wall stage and gather then no longer walk. The rebuild rule keeps that list
+  // complete: the free particles and the wall may then close only skin/2 between them (step.cpp).
+  bool candidates_within_half_skin = false;
 };
 
 // Ball-wall contacts within the skin, sorted by (particle, wall, facet). The particle plays the

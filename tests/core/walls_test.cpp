@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "asperity/world.hpp"
+#include "state.hpp"
 
 using namespace asperity;
 
@@ -20,6 +21,14 @@ void flat_mesh(int cells, double h, std::vector<Vec3>& v, std::vector<std::array
       t.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
       t.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
     }
+}
+
+// The same mesh added to a world; returns the wall.
+int add_flat_mesh(World& w, int cells, double h, const ContactMaterial& m = {}) {
+  std::vector<Vec3> v;
+  std::vector<std::array<int, 3>> t;
+  flat_mesh(cells, h, v, t);
+  return w.add_mesh(v, t, m);
 }
 
 // Press a sphere onto the mesh at (x, y) with force F and let it settle; return the overlap.
@@ -167,4 +176,90 @@ TEST(Walls, RemovedWallNoLongerActs) {
   w.cycle(10);
   EXPECT_EQ(w.position(id).z, z);
   EXPECT_THROW(w.wall_force(7), Error);
+}
+
+// A mesh standing still at the neighbour build lists a free particle's triangles only within
+// R + skin/2 (Wall::candidates_within_half_skin, neighbor/build.cpp); a moving mesh, and a rigid
+// group's member, within R + skin.
+TEST(Walls, StillMeshListsFreeParticlesWithinHalfTheSkin) {
+  const double h = 4e-4, R = 5e-4, skin = 2e-4;
+  auto candidates = [&](double gap, bool mesh_moves, bool in_group) {
+    WorldSettings ws;
+    ws.rotation = false;
+    ws.skin = skin;
+    World w(ws);
+    const int mesh = add_flat_mesh(w, 8, h);
+    const auto id = w.add_particle({3.3 * h, 3.6 * h, R + gap}, R);
+    if (in_group) w.add_group(std::vector<std::int64_t>{id});
+    if (mesh_moves) w.set_wall_velocity(mesh, {1e-9, 0, 0});
+    w.rebuild_neighbors();
+    EXPECT_EQ(w.state().walls.walls[mesh].candidates_within_half_skin, !mesh_moves);
+    return w.state().walls.contacts.n;
+  };
+  EXPECT_GT(candidates(0.4 * skin, false, false), 0u);
+  EXPECT_EQ(candidates(0.6 * skin, false, false), 0u) << "beyond R + skin/2 of a still mesh";
+  EXPECT_GT(candidates(0.6 * skin, true, false), 0u) << "a moving mesh: the whole skin";
+  EXPECT_GT(candidates(0.6 * skin, false, true), 0u) << "a group's member: the whole skin";
+  EXPECT_EQ(candidates(1.1 * skin, true, false), 0u);
+}
+
+// A still mesh that left a free sphere off its list (farther than R + skin/2) and then starts
+// moving towards it may close only skin/2 before the list is rebuilt (step.cpp). So the contact
+// starts in the step the mesh reaches the sphere: after the first step with a wall force the
+// overlap is at most two steps of the mesh's travel (the one its force was computed at, and the
+// move after it). Under the whole-skin rule the mesh would pass 0.3 skin (15 steps) into the
+// sphere unseen.
+TEST(Walls, StillMeshSetMovingCatchesTheSphereItLeftOff) {
+  WorldSettings ws;
+  ws.rotation = false;
+  const double h = 4e-4, R = 5e-4, skin = 2e-4;
+  ws.skin = skin;
+  World w(ws);
+  const int mesh = add_flat_mesh(w, 8, h);
+  const auto id = w.add_particle({3.3 * h, 3.6 * h, R + 0.7 * skin}, R);
+  w.cycle(1);
+  ASSERT_EQ(w.state().walls.contacts.n, 0u) << "the sphere is off the still mesh's list";
+  const double travel = skin / 50;  // per step
+  w.set_wall_velocity(mesh, {0, 0, travel / w.dt()});
+  int steps = 0;
+  while (w.wall_force(mesh).z == 0 && steps < 100) {
+    w.cycle(1);
+    ++steps;
+  }
+  ASSERT_LT(steps, 100) << "the mesh never touched the sphere";
+  EXPECT_GE(steps, 34) << "0.7 skin at skin / 50 a step";
+  const double overlap = R - (w.position(id).z - w.wall_displacement(mesh).z);
+  EXPECT_GT(overlap, 0);
+  EXPECT_LE(overlap, 2 * travel) << "caught late, after " << steps << " steps";
+}
+
+// The free sphere's version of SlidingOverAFineMeshKeepsTheContactAcrossTriangles: a frictionless
+// sphere sliding on its own over a still fine mesh, whose list holds its triangles within
+// R + skin/2 only, takes each triangle's contact over in the step it reaches it.
+TEST(Walls, FreeSphereSlidingOverAStillMeshKeepsItsContact) {
+  WorldSettings ws;
+  ws.rotation = false;
+  World w(ws);
+  const double h = 1e-4, R = 5e-4, F = 1e-5, kn = 0.1;
+  ContactMaterial frictionless;
+  frictionless.friction = 0;
+  const int mesh = add_flat_mesh(w, 60, h, frictionless);
+  const auto id = w.add_particle({1.5e-3, 2.05e-3, R - F / kn}, R);
+  w.set_applied_force(id, {0, 0, -F});
+  w.cycle(3000);  // settled
+  w.set_velocity(id, {1e-4, 0, 0});
+  const double x0 = w.position(id).x;
+  const auto rebuilds = w.stats().rebuilds;
+  double low = 1, high = -1;
+  for (int k = 0; k < 300; ++k) {
+    w.cycle(10);
+    low = std::min(low, w.position(id).z);
+    high = std::max(high, w.position(id).z);
+    ASSERT_EQ(w.stats().wall_contacts, 1u) << "after " << 10 * (k + 1) << " steps";
+  }
+  EXPECT_TRUE(w.state().walls.walls[mesh].candidates_within_half_skin);
+  EXPECT_GT(w.position(id).x - x0, 8 * h);
+  EXPECT_GT(w.stats().rebuilds, rebuilds + 5);
+  EXPECT_NEAR(low, R - F / kn, 1e-9);
+  EXPECT_NEAR(high, R - F / kn, 1e-9);
 }
