@@ -44,8 +44,9 @@ std::size_t agree_to_scale(const Ref& ref, const Got& got, std::size_t n, double
 
 // `n` spheres of random radius on a jittered grid (no overlaps) in a box of six planes, falling
 // with random velocities, friction and rotation: a busy scene with rebuilds, slips and wall
-// contacts. Gravity is scaled to the soft model (kn = 0.1 N/m) so overlaps stay small.
-inline World random_box(int n, WorldSettings ws = {}, unsigned seed = 1) {
+// contacts. Gravity is scaled to the soft model (kn = 0.1 N/m) so overlaps stay small. `lift`
+// raises the spheres and the lid (room for a mesh on the floor).
+inline World random_box(int n, WorldSettings ws = {}, unsigned seed = 1, double lift = 0) {
   ws.gravity = {0, 0, -0.02};
   World w(ws);
   std::mt19937_64 rng(seed);
@@ -58,7 +59,7 @@ inline World random_box(int n, WorldSettings ws = {}, unsigned seed = 1) {
     const double slack = cell / 2 - r;
     const auto id = w.add_particle({(cx + 0.5) * cell + slack * (2 * u(rng) - 1),
                                     (cy + 0.5) * cell + slack * (2 * u(rng) - 1),
-                                    (cz + 0.5) * cell + slack * (2 * u(rng) - 1)}, r);
+                                    lift + (cz + 0.5) * cell + slack * (2 * u(rng) - 1)}, r);
     w.set_velocity(id, {2e-3 * (u(rng) - 0.5), 2e-3 * (u(rng) - 0.5), 2e-3 * (u(rng) - 0.5)});
   }
   w.add_plane({0, 0, 0}, {0, 0, 1});
@@ -66,7 +67,7 @@ inline World random_box(int n, WorldSettings ws = {}, unsigned seed = 1) {
   w.add_plane({L, 0, 0}, {-1, 0, 0});
   w.add_plane({0, 0, 0}, {0, 1, 0});
   w.add_plane({0, L, 0}, {0, -1, 0});
-  w.add_plane({0, 0, 2 * L + double(n / (side * side)) * cell}, {0, 0, -1});
+  w.add_plane({0, 0, lift + 2 * L + double(n / (side * side)) * cell}, {0, 0, -1});
   return w;
 }
 
