@@ -178,6 +178,7 @@ struct State {
   // platens: scanning them all every step was 3 % of its elastic step), valid while the bond list
   // is the one of version group_bonds_of.
   std::vector<std::uint32_t> group_pairs, group_bonds;
+  std::vector<std::uint32_t> group_bond_ends;  // per group: its ends of group_bonds
   std::uint64_t group_pairs_at = ~std::uint64_t(0);
   std::uint64_t group_bonds_of = ~std::uint64_t(0);  // the bond_version they were taken from
 

@@ -251,13 +251,18 @@ void update_servo_stiffness(State& s) {
     for (Dof d : g.motion.translation) servo = servo || d == Dof::servo;
   if (!servo) return;
   const ParticleStore& p = s.p;
-  if (s.group_pairs_at != s.rebuilds || s.group_bonds_of != s.bond_version) {
+  if (s.group_pairs_at != s.rebuilds || s.group_bonds_of != s.bond_version ||
+      s.group_bond_ends.size() != s.groups.size()) {
     s.group_pairs.clear();
     for (std::size_t k = 0; k < s.pairs.n; ++k)
       if (p.group[s.pairs.a[k]] != p.group[s.pairs.b[k]]) s.group_pairs.push_back(std::uint32_t(k));
     s.group_bonds.clear();
     for (std::size_t k = 0; k < s.bonds.n; ++k)
       if (p.group[s.bonds.a[k]] != p.group[s.bonds.b[k]]) s.group_bonds.push_back(std::uint32_t(k));
+    s.group_bond_ends.assign(s.groups.size(), 0);
+    for (std::uint32_t k : s.group_bonds)
+      for (const std::int64_t i : {s.bonds.a[k], s.bonds.b[k]})
+        if (p.group[i] >= 0) ++s.group_bond_ends[std::size_t(p.group[i])];
     s.group_pairs_at = s.rebuilds;
     s.group_bonds_of = s.bond_version;
   }
@@ -271,8 +276,12 @@ void update_servo_stiffness(State& s) {
   const double kn = s.settings.contact.kn;
   for (std::uint32_t k : s.group_pairs)
     if (s.pairs.overlap_at(k) > 0) add(s.pairs.a[k], s.pairs.b[k], kn);
-  // The same sums as over every pair and bond: the others (one body) add nothing.
-  for (std::uint32_t k : s.group_bonds) add(s.bonds.a[k], s.bonds.b[k], kn + s.bonds.material.beam_kn);
+  // The same sums as over every pair and bond: the others (one body) add nothing. Every bond adds
+  // the same kn + beam_kn to each group it ties, so a group's sum takes that term once per end it
+  // holds, in any order: the same additions, without reading the bonds and groups each step.
+  const double kb = kn + s.bonds.material.beam_kn;
+  for (std::size_t g = 0; g < s.groups.size(); ++g)
+    for (std::uint32_t e = 0; e < s.group_bond_ends[g]; ++e) K[g] += kb;
   const WallContacts& wc = s.walls.contacts;
   for (std::size_t k = 0; k < wc.n; ++k) {
     const int g = p.group[wc.particle[k]];

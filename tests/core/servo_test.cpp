@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "asperity/world.hpp"
+#include "state.hpp"
 
 using namespace asperity;
 
@@ -176,6 +177,61 @@ TEST(Servo, GainFollowsTheContactsOfEveryStep) {
     worst = std::max(worst, std::fabs(w.group_force(platen).z / target - 1));
   }
   EXPECT_LT(worst, 1e-3) << "settled within 60 steps and held";
+}
+
+// The stiffness the servo's gain divides by (bodies/groups.cpp): per body, kn for each touching
+// contact with another body, kn + beam_kn for each bond to another body, the wall's kn for each
+// wall contact. A 3 x 3 platen (servo) pressed 1 % onto a 3 x 3 layer held as a second body, which
+// rests on a third free layer; five of the nine pairs of each interface bonded, and a side wall
+// touching both bodies. Both bodies' sums equal the counts over the world's contacts and bonds.
+TEST(Servo, StiffnessCountsEveryContactAndBondWithAnotherBody) {
+  WorldSettings ws;
+  ws.rotation = false;
+  World w(ws);
+  const double a = 2 * kR;
+  std::vector<std::int64_t> platen, middle, bottom, half;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      bottom.push_back(w.add_particle({i * a, j * a, kR}, kR));
+      middle.push_back(w.add_particle({i * a, j * a, kR + 0.99 * a}, kR));
+      platen.push_back(w.add_particle({i * a, j * a, kR + 1.98 * a}, kR));
+      if ((i + j) % 2 == 0) half.insert(half.end(), {bottom.back(), middle.back(), platen.back()});
+    }
+  w.add_plane({0, 0, 0}, {0, 0, 1});
+  ContactMaterial wall_material;
+  wall_material.kn = 0.37;
+  w.add_plane({-0.99 * kR, 0, 0}, {1, 0, 0}, wall_material);  // touches the column i = 0 of each layer
+  BondMaterial bm;
+  bm.beam_kn = 0.23;
+  bm.tensile_strength = 1e9;
+  ASSERT_GT(w.install_bonds(bm, 1e-6, half), 0u);
+  const int top = w.add_group(platen, servo_z(2e-5));
+  GroupMotion held;
+  held.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
+  const int mid = w.add_group(middle, held);
+  auto body = [&](std::int64_t id) {
+    for (auto p : platen) if (p == id) return top;
+    for (auto p : middle) if (p == id) return mid;
+    return -1;
+  };
+  auto expected = [&](int g) {
+    const double kn = ws.contact.kn;
+    double K = 3 * wall_material.kn;  // the side wall's contacts (three members of either body)
+    for (const ContactInfo& c : w.contacts())
+      if (body(c.id_a) != body(c.id_b) && (body(c.id_a) == g || body(c.id_b) == g)) K += kn;
+    for (const BondInfo& b : w.bonds())
+      if (body(b.id_a) != body(b.id_b) && (body(b.id_a) == g || body(b.id_b) == g)) K += kn + bm.beam_kn;
+    return K;
+  };
+  w.cycle(1);
+  const auto& groups = w.state().groups;
+  EXPECT_NEAR(groups[top].contact_stiffness, expected(top), 1e-12);
+  EXPECT_NEAR(groups[mid].contact_stiffness, expected(mid), 1e-12);
+  // Not vacuous: both interfaces hold contacts and bonds, and the side wall touches three
+  // members of each body.
+  EXPECT_NEAR(expected(top), 9 * ws.contact.kn + 5 * bm.beam_kn + 3 * wall_material.kn, 1e-12);
+  EXPECT_NEAR(expected(mid), 18 * ws.contact.kn + 10 * bm.beam_kn + 3 * wall_material.kn, 1e-12);
+  EXPECT_EQ(w.stats().wall_contacts, 9u) << "the side wall touches column i = 0 of the three layers";
 }
 
 // Setting the motion again with the servo unchanged (as a shear test does when it changes the
