@@ -78,6 +78,8 @@ local P = require("params").defaults{
   progress = true,
   save = "",               -- a path: the world's checkpoint when the shear ends (to continue from it,
                            -- or to time the shear step in one process: perf/README.md, perf/ab.sh)
+  stop_after = "",         -- "packing": stop once the halves are packed, before bonding (the world
+                           -- saved to `save` if given: to look at the packing, or to time its step)
 }
 if P.scale == "thesis" then
   if params.size == nil then P.size = 0.1 end
@@ -87,6 +89,9 @@ end
 local models = {rigid = true, elastic = true, fracture = true}
 if not models[P.model] then error("model must be rigid, elastic or fracture, got '" .. P.model .. "'") end
 if P.direction ~= "x" and P.direction ~= "y" then error("direction must be x or y") end
+if P.stop_after ~= "" and P.stop_after ~= "packing" then
+  error("stop_after must be \"packing\" or empty, got '" .. P.stop_after .. "'")
+end
 for _, key in ipairs{"quasi_static_limit", "overlap_limit"} do
   if not (P[key] > 0) then error(("%s must be > 0, got %s"):format(key, tostring(P[key]))) end
 end
@@ -170,6 +175,16 @@ local function build_specimen()
   log("packed in %d steps (%.0f s): porosity %.3f nominal, %.3f true; unbalanced-force ratio %.2g%s",
       packed.steps, packed.seconds, packed.porosity_nominal, packed.porosity_true, packed.ratio,
       packed.reached and "" or (" (not below 1e-4 within pack_steps = %d)"):format(P.pack_steps))
+  if P.stop_after == "packing" then
+    if P.save ~= "" then
+      w:save(P.save)
+      log("saved the packed world to %s", P.save)
+    end
+    return nil, {stopped_after = "packing", particles = w:particle_count(), steps = packed.steps,
+                 ratio = packed.ratio, porosity_nominal = packed.porosity_nominal,
+                 porosity_true = packed.porosity_true, seconds = packed.seconds,
+                 saved = P.save ~= "" and P.save or nil}
+  end
   -- Mean compressive stress on the box walls: what the bonds will lock in once the walls go.
   local box = {x_min = planes[1], x_max = planes[2], y_min = planes[3], y_max = planes[4],
                bottom = planes[5], top = planes[6]}
@@ -247,10 +262,15 @@ local world
 local f = io.open(cache_file, "r")
 if f then
   f:close()
+  if P.stop_after == "packing" then
+    error(("stop_after=packing needs a packing, but the specimen is cached (%s): give another cache="):format(cache_file), 0)
+  end
   log("reusing the cached specimen %s", cache_file)
   world = asperity.load(cache_file, {threads = P.threads, simd = P.simd})
 else
-  world = build_specimen()
+  local packing
+  world, packing = build_specimen()
+  if not world then return packing end   -- stop_after = "packing"
   if P.simd ~= "auto" then world = asperity.load(cache_file, {threads = P.threads, simd = P.simd}) end
 end
 -- Numerical settings of the test (perf/runtime_vs_error.lua chose them; 0 keeps the engine's).

@@ -72,6 +72,18 @@ for _, f in ipairs{"summary.json", "shear.csv", "shear.h5", "closure.csv", "clos
   assert(fh, "missing " .. f)
   fh:close()
 end
+-- stop_after=packing: the packed halves, before bonding, saved; nothing else run or written.
+local packed_file = out .. "/packed_only.h5"
+local po = joint{surface = "S1", model = "elastic", stop_after = "packing", save = packed_file,
+                 cache = out .. "/cache_packed_only", out = out .. "/packed_only"}
+assert(po.stopped_after == "packing" and po.saved == packed_file, "stop_after=packing returns the packing")
+assert(po.steps > 0 and po.porosity_nominal > 0.5 and po.porosity_nominal < 0.52,
+       ("packed to porosity %.4f nominal"):format(po.porosity_nominal))
+local pw = asperity.load(packed_file, {threads = 1})
+assert(pw:particle_count() == po.particles and po.particles == el.n_particles + el.left_out_particles,
+       ("%d particles saved, %d in the elastic joint's packing"):format(pw:particle_count(), el.n_particles + el.left_out_particles))
+assert(pw:bond_count() == 0, "saved before bonding")
+assert(io.open(out .. "/packed_only/summary.json") == nil, "no shear run, no summary")
 -- The shear record read back from HDF5 ends at the requested displacement.
 local d = asperity.read_h5(out .. "/S1_elastic/shear.h5", "/displacement")
 assert(d[#d] >= 1.0 - 1e-9, "sheared to 1 mm")
