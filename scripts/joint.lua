@@ -178,7 +178,9 @@ local function build_specimen()
   if P.stop_after == "packing" then
     if P.save ~= "" then
       w:save(P.save)
-      log("saved the packed world to %s", P.save)
+      log("stopped after packing (stop_after): saved the packed world to %s", P.save)
+    else
+      log("stopped after packing (stop_after); nothing saved (give save=FILE to keep the world)")
     end
     return nil, {stopped_after = "packing", particles = w:particle_count(), steps = packed.steps,
                  ratio = packed.ratio, porosity_nominal = packed.porosity_nominal,
