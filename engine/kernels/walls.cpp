@@ -41,6 +41,19 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, cons
 }
 
 void bin_mesh(Mesh& mesh) {
+  // The other triangle on each edge: -1 on the boundary, -2 where several share it.
+  mesh.edge_neighbour.assign(3 * mesh.triangles.size(), -1);
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    for (int e = 0; e < 3; ++e) {
+      const int va = mesh.triangles[t][e], vb = mesh.triangles[t][(e + 1) % 3];
+      std::int32_t& across = mesh.edge_neighbour[3 * t + std::size_t(e)];
+      for (std::int32_t k = mesh.vertex_start[va]; k < mesh.vertex_start[va + 1]; ++k) {
+        const std::int32_t o = mesh.vertex_triangles[k];
+        const auto& ot = mesh.triangles[o];
+        if (std::size_t(o) == t || (ot[0] != vb && ot[1] != vb && ot[2] != vb)) continue;
+        across = across == -1 ? o : -2;
+      }
+    }
   TriangleBins& g = mesh.bins;
   Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
   double edge_sum = 0;
@@ -144,21 +157,32 @@ bool mesh_feature_contact_is_real(const Mesh& mesh, int t, int feature, const Ve
     vb = tri[(feature - 3) % 3];
   }
   const double limit = d * (1 - 1e-9), tie = d * (1 + 1e-9);
+  // Whether triangle o, which shares the feature, takes the contact from t.
+  auto takes_it = [&](std::int32_t o) {
+    const auto& ot = mesh.triangles[o];
+    int f;
+    const Vec3 cp = closest_point_on_triangle(q, mesh.vertices[ot[0]], mesh.vertices[ot[1]],
+                                              mesh.vertices[ot[2]], f);
+    const double od = norm(q - cp);
+    // Equally close, and its face holds the closest point: the sphere is over the flat join of
+    // two triangles, a hair past the edge (its distance to the edge and to the face agree to
+    // ~1e-11 within 1e-8 m of the edge line). The face counts the contact, so the edge must not:
+    // both did, and a sphere sliding over a flat mesh got twice its normal force for a step.
+    return od < limit || (f == 0 && od <= tie);
+  };
+  // An edge shared by one other triangle (Mesh::edge_neighbour): that one alone, without walking
+  // the triangles around the vertex (the same set, so the same answer).
+  if (vb >= 0 && !mesh.edge_neighbour.empty()) {
+    const std::int32_t across = mesh.edge_neighbour[3 * std::size_t(t) + std::size_t(feature - 4)];
+    if (across == -1) return true;
+    if (across >= 0) return !takes_it(across);
+  }
   for (std::int32_t k = mesh.vertex_start[va]; k < mesh.vertex_start[va + 1]; ++k) {
     const std::int32_t o = mesh.vertex_triangles[k];
     if (o == t) continue;
     const auto& ot = mesh.triangles[o];
     if (vb >= 0 && ot[0] != vb && ot[1] != vb && ot[2] != vb) continue;  // does not share the edge
-    int f;
-    const Vec3 cp = closest_point_on_triangle(q, mesh.vertices[ot[0]], mesh.vertices[ot[1]],
-                                              mesh.vertices[ot[2]], f);
-    const double od = norm(q - cp);
-    if (od < limit) return false;
-    // Equally close, and its face holds the closest point: the sphere is over the flat join of
-    // two triangles, a hair past the edge (its distance to the edge and to the face agree to
-    // ~1e-11 within 1e-8 m of the edge line). The face counts the contact, so the edge must not:
-    // both did, and a sphere sliding over a flat mesh got twice its normal force for a step.
-    if (f == 0 && od <= tie) return false;
+    if (takes_it(o)) return false;
   }
   return true;
 }

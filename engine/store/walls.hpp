@@ -32,6 +32,9 @@ struct Mesh {
   // triangle sharing that feature is closer to the sphere (otherwise that triangle's face or
   // edge is the contact, and this one is its shadow).
   std::vector<std::int32_t> vertex_start, vertex_triangles;
+  // Per triangle and edge (AB, BC, CA): the one other triangle sharing it, -1 if none, -2 if
+  // several (derived by bin_mesh, like the bins).
+  std::vector<std::int32_t> edge_neighbour;
   TriangleBins bins;
 
   // Its arrays past the caches (4 MB, as records_past_caches in state.hpp): a thesis-scale mould
@@ -40,7 +43,7 @@ struct Mesh {
   // scale and would cost 1.17 in cache (kernels/walls.cpp, perf/README.md).
   bool past_caches() const {
     const std::size_t bytes = vertices.size() * sizeof(Vec3) + triangles.size() * sizeof(triangles[0]) +
-                              owns.size() + (vertex_start.size() + vertex_triangles.size()) * sizeof(std::int32_t);
+                              owns.size() + (vertex_start.size() + vertex_triangles.size() + edge_neighbour.size()) * sizeof(std::int32_t);
     return bytes > (std::size_t(4) << 20);
   }
 };

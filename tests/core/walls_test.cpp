@@ -178,6 +178,37 @@ TEST(Walls, RemovedWallNoLongerActs) {
   EXPECT_THROW(w.wall_force(7), Error);
 }
 
+// Each edge's other triangle (Mesh::edge_neighbour), which the shared-edge test checks instead of
+// walking the triangles around a vertex: one across an inner edge, none (-1) on the boundary,
+// -2 where three triangles meet on one edge (a fin), which keeps the walk.
+TEST(Walls, EdgeNeighboursOfAMesh) {
+  World w;
+  std::vector<Vec3> v;
+  std::vector<std::array<int, 3>> t;
+  flat_mesh(2, 1e-3, v, t);  // 8 triangles; cell (0, 0) holds triangles 0 and 1
+  v.push_back({1e-3, 1e-3, 1e-3});
+  t.push_back({0, 4, 9});  // a fin on the diagonal edge 0-4 of cell (0, 0)
+  w.add_mesh(v, t);
+  const auto& en = w.state().walls.meshes[0].edge_neighbour;
+  ASSERT_EQ(en.size(), 3 * t.size());
+  // Triangle 0 = (0, 1, 4): edge 0-1 on the boundary, edge 1-4 shared with cell (1, 0)'s
+  // triangle 3 = (1, 5, 4), edge 4-0 shared by triangle 1 and the fin 8.
+  EXPECT_EQ(en[0], -1);
+  EXPECT_EQ(en[1], 3);
+  EXPECT_EQ(en[2], -2);
+  // Triangle 1 = (0, 4, 3): edge 0-4 with triangle 0 and the fin; edge 4-3 shared with cell
+  // (0, 1)'s triangle 4 = (3, 4, 7); edge 3-0 on the boundary.
+  EXPECT_EQ(en[3], -2);
+  EXPECT_EQ(en[4], 4);
+  EXPECT_EQ(en[5], -1);
+  // Every inner edge is seen from both sides.
+  for (std::size_t k = 0; k < en.size(); ++k)
+    if (en[k] >= 0) {
+      const int o = en[k];
+      EXPECT_TRUE(en[3 * o] == int(k / 3) || en[3 * o + 1] == int(k / 3) || en[3 * o + 2] == int(k / 3)) << k;
+    }
+}
+
 // A mesh standing still at the neighbour build lists a free particle's triangles only within
 // R + skin/2 (Wall::candidates_within_half_skin, neighbor/build.cpp); a moving mesh, and a rigid
 // group's member, within R + skin.
