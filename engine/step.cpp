@@ -94,8 +94,9 @@ void bookkeep(State& s) {
     if (d > first) second = first, first = d;
     else if (d > second) second = d;
   };
+  const double free_move = max_disp2 > 0 ? std::sqrt(max_disp2) : 0.0;  // largest free-particle move
   if (!(max_disp2 == max_disp2)) first = max_disp2;  // NaN: rebuild, the health check reports it
-  else if (max_disp2 > 0) body(std::sqrt(max_disp2)), body(std::sqrt(max_disp2));  // two free particles
+  else if (max_disp2 > 0) body(free_move), body(free_move);  // two free particles
   for (std::size_t gi = 0; gi < s.groups.size(); ++gi) {
     const Group& g = s.groups[gi];
     double d2 = 0;
@@ -129,7 +130,6 @@ void bookkeep(State& s) {
   // wall contact likewise needs the particle and the wall to close `skin`, or skin/2 for the
   // free particles of a mesh that listed them within R + skin/2 (Wall::candidates_within_half_
   // skin; while the mesh stands still the pair rule already keeps free particles within skin/2).
-  const double free_move = max_disp2 > 0 ? std::sqrt(max_disp2) : 0.0;
   double wall_move = 0;
   for (const auto& w : s.walls.walls) {
     const double move = norm(w.displacement - w.displacement_at_build);

@@ -40,6 +40,10 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, cons
   return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
+namespace {
+bool holds_vertex(const std::array<int, 3>& tri, int v) { return tri[0] == v || tri[1] == v || tri[2] == v; }
+}  // namespace
+
 void bin_mesh(Mesh& mesh) {
   // The other triangle on each edge: -1 on the boundary, -2 where several share it.
   mesh.edge_neighbour.assign(3 * mesh.triangles.size(), -1);
@@ -49,8 +53,7 @@ void bin_mesh(Mesh& mesh) {
       std::int32_t& across = mesh.edge_neighbour[3 * t + std::size_t(e)];
       for (std::int32_t k = mesh.vertex_start[va]; k < mesh.vertex_start[va + 1]; ++k) {
         const std::int32_t o = mesh.vertex_triangles[k];
-        const auto& ot = mesh.triangles[o];
-        if (std::size_t(o) == t || (ot[0] != vb && ot[1] != vb && ot[2] != vb)) continue;
+        if (std::size_t(o) == t || !holds_vertex(mesh.triangles[o], vb)) continue;
         across = across == -1 ? o : -2;
       }
     }
@@ -180,8 +183,7 @@ bool mesh_feature_contact_is_real(const Mesh& mesh, int t, int feature, const Ve
   for (std::int32_t k = mesh.vertex_start[va]; k < mesh.vertex_start[va + 1]; ++k) {
     const std::int32_t o = mesh.vertex_triangles[k];
     if (o == t) continue;
-    const auto& ot = mesh.triangles[o];
-    if (vb >= 0 && ot[0] != vb && ot[1] != vb && ot[2] != vb) continue;  // does not share the edge
+    if (vb >= 0 && !holds_vertex(mesh.triangles[o], vb)) continue;  // does not share the edge
     if (takes_it(o)) return false;
   }
   return true;

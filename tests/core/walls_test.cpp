@@ -36,10 +36,7 @@ double settle_on_mesh(double x, double y, int cells, double h, std::size_t* cont
   WorldSettings ws;
   ws.rotation = false;
   World w(ws);
-  std::vector<Vec3> v;
-  std::vector<std::array<int, 3>> t;
-  flat_mesh(cells, h, v, t);
-  w.add_mesh(v, t);
+  add_flat_mesh(w, cells, h);
   const double R = 5e-4, F = 1e-5;
   const auto id = w.add_particle({x, y, R - 0.5 * F / 0.1}, R);
   w.set_applied_force(id, {0, 0, -F});
@@ -119,11 +116,8 @@ TEST(Walls, SlidingOverAFineMeshKeepsTheContactAcrossTriangles) {
     WorldSettings ws;
     ws.rotation = false;
     World w(ws);
-    std::vector<Vec3> v;
-    std::vector<std::array<int, 3>> t;
     const double h = 1e-4, R = 5e-4, F = 1e-5, kn = 0.1;
-    flat_mesh(60, h, v, t);  // 6 mm square of 0.1 mm cells
-    const int mesh = w.add_mesh(v, t);
+    const int mesh = add_flat_mesh(w, 60, h);  // 6 mm square of 0.1 mm cells
     const auto id = w.add_particle({1.5e-3, 2.05e-3, R - F / kn}, R);
     GroupMotion slide;
     slide.translation = {Dof::velocity, Dof::fixed, Dof::free};
