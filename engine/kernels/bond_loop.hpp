@@ -36,10 +36,14 @@ double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
     const T crit = bond_forces<T, Rotation, Moments>(nx, ny, nz, U, la, lb, rsafe, q.vax, q.vay, q.vaz,
                                             q.wax, q.way, q.waz, q.vbx, q.vby, q.vbz, q.wbx, q.wby,
                                             q.wbz, ox, oy, oz, u0, s, sigma, tau, p);
-    T brk(0.0);
     if (breakable) {
-      brk = select(real & (crit >= T(1.0)), T(1.0), T(0.0));
+      // The flags stay 0 but where a bond breaks (process_breaks removes those; bond_stage clears
+      // the column after a step whose breaks were not processed), so only such a batch stores:
+      // a column written every step for nothing cost the thesis-scale joint a fifth of its step
+      // on one thread (perf/README.md, "Stores nobody needs").
+      const T brk = select(real & (crit >= T(1.0)), T(1.0), T(0.0));
       count = count + brk;
+      if (any(brk != T(0.0))) Lanes::store(k.broken + i, brk);
     }
     Lanes::store(k.nx + i, nx); Lanes::store(k.ny + i, ny); Lanes::store(k.nz + i, nz);
     Lanes::store(k.fsx + i, s.fsx); Lanes::store(k.fsy + i, s.fsy); Lanes::store(k.fsz + i, s.fsz);
@@ -52,7 +56,6 @@ double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
       Lanes::store(k.mbn + i, s.mbn);
       Lanes::store(k.mbsx + i, s.mbsx); Lanes::store(k.mbsy + i, s.mbsy); Lanes::store(k.mbsz + i, s.mbsz);
     }
-    Lanes::store(k.broken + i, brk);
     // For the gather (kernels/integrate.cpp), with the operations it would do per side: the
     // record fx fy fz U cx cy cz 0 mx my mz 0 of each bond (store/bonds.hpp).
     const T ftot = fn + s.fbn;

@@ -204,6 +204,13 @@ StageLoop bond_stage(State& s) {
   const std::size_t total = s.bonds.padded;
   const std::size_t block = pair_block_size(total);
   st.blocks = (total + block - 1) / block;
+  // The kernel writes a break flag only where a bond breaks: flags of a step whose breaks were
+  // never processed (it stopped before process_breaks) are cleared, not carried into this one.
+  for (const double b : s.bond_block_breaks)
+    if (b != 0) {
+      std::fill(s.bonds.broken.begin(), s.bonds.broken.end(), 0.0);
+      break;
+    }
   s.bond_block_breaks.assign(st.blocks, 0.0);
   double* breaks = s.bond_block_breaks.data();
   st.run = [=](std::size_t blk) {

@@ -55,6 +55,7 @@ inline bool operator<(const F32& a, const F32& b) { return a.v < b.v; }
 inline bool operator>(const F32& a, const F32& b) { return a.v > b.v; }
 inline bool operator<=(const F32& a, const F32& b) { return a.v <= b.v; }
 inline bool operator>=(const F32& a, const F32& b) { return a.v >= b.v; }
+inline bool operator!=(const F32& a, const F32& b) { return a.v != b.v; }
 inline F32 select(bool m, const F32& a, const F32& b) { return m ? a : b; }
 inline F32 sqrt(const F32& a) { return F32::of(std::sqrt(a.v)); }
 
@@ -87,6 +88,7 @@ struct FloatLanes {
   static F32 load(const double* p) { return F32(*p); }
   static void store(double* p, const F32& v) { *p = double(v.v); }
   static double sum(const F32& v) { return double(v.v); }
+  static void store_flags(std::uint8_t* p, const F32& v) { *p = v.v != 0.0f; }
   template <int Width, bool Stream = false>  // Stream: ignored (plain stores)
   static void store_records(double* rec, const F32* v) {
     for (int j = 0; j < Width; ++j) rec[j] = double(v[j].v);

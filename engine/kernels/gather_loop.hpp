@@ -22,6 +22,11 @@ inline bool gather_skips(const GatherArgs& g, std::size_t i) {
   return (g.inert && g.inert[i]) || (g.idle && g.idle[i]);
 }
 
+// A pair whose stage wrote only zeros but its overlap (GatherArgs::live).
+inline bool skips_record(const GatherArgs& g, std::int64_t entry) {
+  return g.live && !g.live[std::size_t(entry >> 1)];
+}
+
 // Bonds = false: the pair list (records of 8); true: the bond list (records of 12), with the
 // beam's moment, which acts on b and its negative on a, unless Moment = false: every moment is
 // zero (GatherArgs::moments), and t - lever C is what t + (s 0 - lever C) gives.
@@ -30,6 +35,7 @@ inline void add_incidences_scalar(const GatherArgs& g, std::size_t i, double R, 
                                   double t[3]) {
   constexpr std::size_t width = Moment ? 12 : 8;
   for (std::int32_t e = g.start[i]; e < g.start[i + 1]; ++e) {
+    if (!Bonds && skips_record(g, g.entry[e])) continue;
     const double* r = g.records + width * std::size_t(g.entry[e] >> 1);
     const double sgn = (g.entry[e] & 1) ? 1.0 : -1.0;
     f[0] += sgn * r[0];
@@ -82,7 +88,8 @@ template <bool Moment>
 inline void prefetch_records(const GatherArgs& g, std::size_t i) {
   constexpr std::size_t width = Moment ? 12 : 8;
   for (std::int32_t e = g.start[i]; e < g.start[i + 1]; ++e)
-    _mm_prefetch(reinterpret_cast<const char*>(g.records + width * std::size_t(g.entry[e] >> 1)),
+    if (!skips_record(g, g.entry[e]))
+      _mm_prefetch(reinterpret_cast<const char*>(g.records + width * std::size_t(g.entry[e] >> 1)),
                  _MM_HINT_T0);
 }
 
@@ -94,6 +101,7 @@ inline void add_incidences_vector(const GatherArgs& g, std::size_t i, __m256d R,
   const __m256d half = _mm256_set1_pd(0.5);
   for (std::int32_t e = g.start[i]; e < g.start[i + 1]; ++e) {
     const std::int64_t entry = g.entry[e];
+    if (!Bonds && skips_record(g, entry)) continue;
     const double* r = g.records + width * std::size_t(entry >> 1);
     const __m256d s = _mm256_broadcast_sd(sign + (entry & 1));
     const __m256d lever = _mm256_sub_pd(R, _mm256_mul_pd(half, _mm256_broadcast_sd(r + 3)));

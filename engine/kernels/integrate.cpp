@@ -52,7 +52,11 @@ StageLoop integrate_stage(State& s) {
                                 p.radius.data(), p.inert.data(), idle, p.fx.data(),
                                 p.fy.data(), p.fz.data(), p.tx.data(), p.ty.data(),
                                 p.tz.data()};
+  // Pair records the pair kernel flagged dead (zero forces) are skipped where it flagged them
+  // this step (kernels/pairs.cpp, GatherArgs::live).
+  if (q.live_written) pair_args.live = q.live.data();
   kernels::GatherArgs bond_args = pair_args;
+  bond_args.live = nullptr;
   bond_args.start = binc.start.data();
   bond_args.entry = binc.entry.data();
   bond_args.records = bq.out.data();

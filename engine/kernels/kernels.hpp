@@ -31,16 +31,22 @@ struct PairKernelArgs {
   // null: every rest overlap is 0 and the column is not touched.
   double* rest = nullptr;
   bool stream = false;  // non-temporal record stores (pairs.cpp: record arrays past the caches)
-  // Per stage of kPairStage pairs (null: not kept): 1 where some pair of the stage touched in the
-  // last step, else 0, written by the kernel. A stage that did not touch is computed geometry
-  // first and its kinematics only if it touches now (pair_loop.hpp); the values are the same.
+  // Per stage of kPairStage pairs (null: not kept), written by the kernel: with `live` given, how
+  // many of the stage's records are live (below), else 1 where one of its pairs touches, else 0.
+  // A stage with 0 in the last step is computed geometry first and its kinematics only if it
+  // touches now (pair_loop.hpp), the values the same.
   std::uint8_t* touched = nullptr;
+  // Per pair (null: not written): 1 where its record is live, i.e. not all zeros but for the
+  // overlap U <= 0: the pair touches, carries a normal force or has a NaN overlap; else 0 (the
+  // gather skips those: GatherArgs::live).
+  std::uint8_t* live = nullptr;
 };
 
 using PairKernel = double (*)(const PairKernelArgs&, std::size_t begin, std::size_t end);
 
 // Bond kernel: bonds [begin, end) of the bond list; sets broken[k] = 1 where the elliptic
-// criterion is met (only when strength > 0). Returns the number of bonds broken.
+// criterion is met (only when strength > 0) and leaves the other flags as they are (all 0 between
+// steps: BondStore::broken). Returns the number of bonds broken.
 struct BondKernelArgs {
   const double* x; const double* y; const double* z;
   const double* vx; const double* vy; const double* vz;
@@ -112,6 +118,12 @@ struct GatherArgs {
   // past the caches, whose lines the incidences reach out of order (kernels/integrate.cpp,
   // records_past_caches in state.hpp; perf/README.md).
   bool prefetch = false;
+  // Pair lists: per pair, 0 where its record is zero but for the overlap (PairKernelArgs::live,
+  // from this step's pair kernel); the gather skips those records.
+  // Exact: the terms left out are +-0, and a sum that starts at +0 is never changed by adding
+  // +-0 (it never becomes -0 in round-to-nearest), with the lever R - U/2 finite for U <= 0.
+  // Null: every record is read.
+  const std::uint8_t* live = nullptr;
   // Bond lists: false where the bond kernel without moments wrote the records (every beam moment
   // zero: State::bond_moments_zero): 8 doubles a bond without the moment, whose terms the gather
   // then leaves out; true: 12 with it.

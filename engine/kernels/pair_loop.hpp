@@ -12,10 +12,20 @@
 namespace asperity::kernels {
 
 // Every store of batch i: the history (normal, shear force), the rest overlap, and the record.
+// A pair's record is "live" where it is not all zeros but for the overlap: the pair touches
+// (U > 0), carries a normal force (a broken bond's contact whose rest overlap U0 < 0 pushes
+// within U0 < U <= 0) or has no valid overlap (NaN). Where PairKernelArgs::live is given, its
+// flag goes there and `live` counts them per lane (PairKernelArgs::touched).
 template <class Lanes, class T = typename Lanes::Real>
 inline void store_pair(const PairKernelArgs& k, std::size_t i, const T& nx, const T& ny,
                        const T& nz, const T& U, const T& u0, const T& fx, const T& fy, const T& fz,
-                       const T& fn) {
+                       const T& fn, T& live) {
+  if (k.live) {
+    T lanes = select(U <= T(0.0), T(0.0), T(1.0));
+    lanes = select(fn != T(0.0), T(1.0), lanes);
+    Lanes::store_flags(k.live + i, lanes);
+    live = live + lanes;
+  }
   // A pair that no longer touches forgets its rest overlap with its shear force.
   if (k.rest) Lanes::store(k.rest + i, select(U > T(0.0), u0, T(0.0)));
   Lanes::store(k.nx + i, nx); Lanes::store(k.ny + i, ny); Lanes::store(k.nz + i, nz);
@@ -56,6 +66,12 @@ double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
   const LawParams<T> p{T(k.kn), T(k.ks), T(k.friction), T(k.dt)};
   T slip_sum(0.0);
   alignas(64) double scratch[10][kPairStage];  // n U Vs phi; la lb on the split path
+  T live(0.0);  // per stage, per lane: how many of its records are live (store_pair)
+  // PairKernelArgs::touched: with flags the stage's live records, without whether one touches.
+  auto mark = [&](std::size_t stage, const T& reach) __attribute__((always_inline)) {
+    if (k.touched)
+      k.touched[stage] = k.live ? std::uint8_t(Lanes::sum(live)) : std::uint8_t(any(reach > T(0.0)));
+  };
   // The law's response for batch i of a touching stage and every store of the pair: history,
   // rest overlap and the record.
   auto respond_batch = [&](std::size_t i, const T& nx, const T& ny, const T& nz, const T& U,
@@ -66,12 +82,13 @@ double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
     T fx = Lanes::load(k.fsx + i), fy = Lanes::load(k.fsy + i), fz = Lanes::load(k.fsz + i), fn;
     slip_sum = slip_sum + contact_response<T, Rotation>(nx, ny, nz, U, vsx, vsy, vsz, phi, ox, oy,
                                                         oz, u0, fx, fy, fz, fn, p);
-    store_pair<Lanes>(k, i, nx, ny, nz, U, u0, fx, fy, fz, fn);
+    store_pair<Lanes>(k, i, nx, ny, nz, U, u0, fx, fy, fz, fn, live);
   };
   for (std::size_t first = begin; first < end; first += kPairStage) {
     const std::size_t last = first + kPairStage < end ? first + kPairStage : end;
     const std::size_t stage = first / kPairStage;
     T reach(0.0);  // the largest overlap of the stage (a NaN is not counted: it touches nothing)
+    live = T(0.0);
     if (k.touched && !k.touched[stage]) {
       // Nothing touched here in the last step: the geometry first, and the velocities and the
       // kinematics only if something touches now (in a bonded specimen most stages never do).
@@ -122,7 +139,7 @@ double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
       if constexpr (Lanes::kOnePass) {
         // Done in the one pass. A stage that touched nothing after all got what the no-touch
         // branch below gives (the law selects zero forces where U <= 0).
-        if (k.touched) k.touched[stage] = any(reach > T(0.0));
+        mark(stage, reach);
         continue;
       }
     }
@@ -139,16 +156,15 @@ double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
           // no slip (+0, which leaves the sum as it is), the normal force by the same select.
           const T u0 = k.rest ? Lanes::load(k.rest + i) : T(0.0);
           const T fn = select(U > u0, p.kn * (U - u0), T(0.0)), zero(0.0);
-          store_pair<Lanes>(k, i, nx, ny, nz, U, u0, zero, zero, zero, fn);
+          store_pair<Lanes>(k, i, nx, ny, nz, U, u0, zero, zero, zero, fn, live);
         }
       }
     };
-    const bool touches = any(reach > T(0.0));
-    if (k.touched) k.touched[stage] = touches;
-    if (touches)
+    if (any(reach > T(0.0)))
       respond(std::true_type{});
     else
       respond(std::false_type{});
+    mark(stage, reach);
   }
   return Lanes::sum(slip_sum);
 }

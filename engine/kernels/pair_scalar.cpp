@@ -19,6 +19,7 @@ struct ScalarLanes {
   static bool fits(std::int64_t off) { return off == 0; }
   static double window(const double* p, std::int64_t) { return *p; }
   static double load(const double* p) { return *p; }
+  static void store_flags(std::uint8_t* p, double v) { *p = v != 0.0; }
   static void store(double* p, double v) { *p = v; }
   static double load_u(const double* p) { return *p; }
   static void store_u(double* p, double v) { *p = v; }

@@ -96,6 +96,17 @@ struct SimdLanes {
 #endif
   }
   static Real load(const double* p) { return Real::load_aligned(p); }
+  // A byte per lane, 1 where v is not zero (PairKernelArgs::live).
+  static void store_flags(std::uint8_t* p, const Real& v) {
+#if defined(__AVX512F__)
+    const __mmask8 m = _mm512_cmp_pd_mask(v, _mm512_setzero_pd(), _CMP_NEQ_UQ);
+    _mm512_mask_cvtepi64_storeu_epi8(p, 0xFF, _mm512_maskz_set1_epi64(m, 1));
+#else
+    alignas(64) double l[size];
+    v.store_aligned(l);
+    for (std::size_t j = 0; j < size; ++j) p[j] = l[j] != 0.0;
+#endif
+  }
   static void store(double* p, const Real& v) { v.store_aligned(p); }
   // The wall contact list's columns (std::vector, any alignment) and its 32-bit indices.
   static Real load_u(const double* p) { return Real::load_unaligned(p); }

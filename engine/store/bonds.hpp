@@ -31,7 +31,8 @@ struct BondStore {
   AVec<double> fbsx, fbsy, fbsz;          // parallel bond shear force
   AVec<double> mbn;                       // twisting moment (along n)
   AVec<double> mbsx, mbsy, mbsz;          // bending moment
-  AVec<double> broken;                    // 1 when the criterion was met this step
+  AVec<double> broken;                    // 1 when the criterion was met this step; 0 between
+                                          // steps (the kernel writes only where one breaks)
   // For the gather, computed by the SIMD kernel (outputs of the step only, like PairStore's): the
   // record of bond k is out[kBondRecord k + j], j = 0..11: fx fy fz U cx cy cz 0 mx my mz 0, the
   // force on b (fn + fbn) n + fs + fbs, the overlap, n x (fs + fbs) (torque per lever arm,

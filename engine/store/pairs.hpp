@@ -40,10 +40,16 @@ struct PairStore {
   // reaches a pair through the incidence list in one line instead of seven columns
   // (perf/README.md). Outputs of the step: not carried by rebuilds nor saved.
   AVec<double> out;
-  // Per stage of kTouchStage pairs: whether one of them touched in the last pair stage (kernels.hpp,
-  // PairKernelArgs::touched); 1 where not known. Only chooses how the kernel computes the stage.
+  // Per stage of kTouchStage pairs: how many of its records the last pair stage found live
+  // (kernels.hpp, PairKernelArgs::touched); 1 where not known. Chooses how the kernel computes
+  // the stage, and whether the gather reads the live flags.
   static constexpr std::size_t kTouchStage = 128;
   std::vector<std::uint8_t> touched;
+  // Per pair: 1 where its record is live (not all zeros but for the overlap), written by the pair
+  // kernel where live_written (kernels.hpp, PairKernelArgs::live) for the gather in the same step.
+  std::vector<std::uint8_t> live;
+  bool live_written = false;  // this step's pair kernel writes `live` (kernels/pairs.cpp)
+  bool live_counted = false;  // `touched` holds the last pair kernel's counts of live records
   // Set by the pair stage: the current normal forces and overlaps are in the records (slots 7
   // and 3), the fn and overlap columns are stale. Cleared where the columns are written.
   bool outputs_in_records = false;
@@ -75,6 +81,8 @@ struct PairStore {
   void size_outputs() {
     out.resize(kPairRecord * padded);
     touched.assign(padded / kTouchStage + 1, 1);
+    live.assign(padded, 1);
+    live_counted = false;
     outputs_in_records = false;
   }
   // Padding entries: pair of two null particles, unit normal along x, no force.

@@ -12,6 +12,7 @@
 #include "core/aligned.hpp"
 #include "kernels/kernels.hpp"
 #include "scenes.hpp"
+#include "state.hpp"
 
 using namespace asperity;
 
@@ -212,6 +213,26 @@ TEST(Bonds, ABreakListsTheFreedPairWithoutARebuild) {
   ASSERT_EQ(c.size(), 1u);
   EXPECT_NEAR(c[0].normal_force, 0.1 * c[0].overlap, 1e-12 * c[0].normal_force) << "Fn = kn U";
   EXPECT_NEAR(p.w.group_force(p.gb).z, c[0].normal_force, 1e-12 * c[0].normal_force) << "on b, along +z";
+}
+
+// The bond kernel writes a break flag only where a bond breaks, and process_breaks removes those
+// bonds, so the flags are all 0 between steps. A step that stopped before process_breaks (a
+// health check) leaves its flags behind: the next bond stage clears them instead of carrying
+// them into a later break.
+TEST(Bonds, FlagsOfUnprocessedBreaksAreClearedNotCarried) {
+  BondMaterial bm;
+  bm.tensile_strength = 0.2;
+  Pair p = bonded_pair(bm, moving({0, 0, 0}));
+  p.w.cycle(1);
+  detail::State& s = p.w.state();
+  ASSERT_EQ(s.bonds.n, 1u);
+  EXPECT_EQ(s.bonds.broken[0], 0.0);
+  s.bonds.broken[0] = 1;              // as a kernel would have flagged it ...
+  s.bond_block_breaks.assign(1, 1.0);  // ... in a step whose breaks were never processed
+  p.w.cycle(1);
+  EXPECT_EQ(p.w.bond_count(), 1u) << "the bond holds: nothing pulls on it";
+  EXPECT_EQ(s.bonds.broken[0], 0.0) << "the stale flag is gone";
+  EXPECT_TRUE(p.w.break_events().empty());
 }
 
 TEST(Bonds, ShearBreaksAtFiveTimesTheStrength) {

@@ -295,7 +295,9 @@ TEST(Determinism, SimdKernelsEqualTheScalarReferenceBitwise) {
 // law itself (contact_law.hpp applied to the one pair, the record formed as the kernel forms it),
 // whether it computes a stage in one pass or (a stage that did not touch in the last step:
 // PairKernelArgs::touched) the geometry first and the kinematics after; and it must say which
-// stages touch now.
+// records are live (not all zeros but for the overlap: touching, or pushed by a negative rest
+// overlap, PairKernelArgs::live) and how many per stage, which the gather relies on to skip the
+// others exactly (GatherArgs::live).
 TEST(Determinism, PairKernelSkipsStagesOfNearMissesWithTheLawsBits) {
   const std::size_t pairs = 4096;
   std::vector<const kernels::KernelSet*> sets{&kernels::scalar_kernels()};
@@ -312,6 +314,9 @@ TEST(Determinism, PairKernelSkipsStagesOfNearMissesWithTheLawsBits) {
           const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
           const double f = (base.r[ia] + base.r[ib]) * (1.06 + 0.04 * std::sin(double(k))) / d;
           base.x[ib] = base.x[ia] + f * dx; base.y[ib] = base.y[ia] + f * dy; base.z[ib] = base.z[ia] + f * dz;
+          // A negative rest overlap deeper than the gap: a normal force without touching (the
+          // engine clamps a freed contact's rest overlap at 0, the kernel does not rely on it).
+          if (k % 5 == 1) base.rest[k] = -0.12 * (base.r[ia] + base.r[ib]);
         }
       }
       // The law, pair by pair.
@@ -340,21 +345,38 @@ TEST(Determinism, PairKernelSkipsStagesOfNearMissesWithTheLawsBits) {
                                ny * fz - nz * fy, nz * fx - nx * fz, nx * fy - ny * fx, fn};
         std::copy(rec, rec + 8, law.out.begin() + std::ptrdiff_t(8 * k));
       }
-      std::vector<std::uint8_t> touching(pairs / kernels::kPairStage, 0);
-      for (std::size_t k = 0; k < pairs; ++k) touching[k / kernels::kPairStage] |= law.out[8 * k + 3] > 0;
+      std::vector<std::uint8_t> live(pairs), live_count(pairs / kernels::kPairStage, 0),
+          touching(pairs / kernels::kPairStage, 0);
+      std::size_t pushed = 0;
+      for (std::size_t k = 0; k < pairs; ++k) {
+        live[k] = law.out[8 * k + 3] > 0 || law.out[8 * k + 7] != 0;
+        live_count[k / kernels::kPairStage] += live[k];
+        touching[k / kernels::kPairStage] |= law.out[8 * k + 3] > 0;
+        pushed += live[k] && !(law.out[8 * k + 3] > 0);
+      }
+      if (rest) {
+        ASSERT_GT(pushed, 10u) << "live records of pairs that do not touch";
+      }
       ASSERT_GT(misses, pairs / 2) << "most pairs miss";
       ASSERT_LT(misses, pairs - pairs / 8) << "some touch";
       for (const kernels::KernelSet* ks : sets)
-      for (int last_step : {-1, 0, 1}) {  // touched not kept; no stage touched; every stage did
+      for (int last_step : {-1, 0, 1})  // touched not kept; no stage touched; every stage did
+      for (bool with_flags : {false, true}) {
         RandomPairs got = base;
         std::vector<std::uint8_t> touched(pairs / kernels::kPairStage, std::uint8_t(last_step == 1));
+        std::vector<std::uint8_t> flags(pairs, 7);
         auto args = got.args();
         if (last_step >= 0) args.touched = touched.data();
+        if (with_flags) args.live = flags.data();
         const double slip = (rotation ? ks->pair : ks->pair_norot)(args, 0, pairs);
         const std::string what = std::string(ks->name) + (rotation ? " spin" : " no spin") +
-                                 (rest ? " rest" : "") + " last step " + std::to_string(last_step);
+                                 (rest ? " rest" : "") + " last step " + std::to_string(last_step) +
+                                 (with_flags ? " live flags" : "");
         if (last_step >= 0) {
-          EXPECT_EQ(touched, touching) << what;
+          EXPECT_EQ(touched, with_flags ? live_count : touching) << what;
+        }
+        if (with_flags) {
+          EXPECT_EQ(flags, live) << what;
         }
         EXPECT_NEAR(slip, slip_law, 1e-12 * slip_law) << what;
         EXPECT_GT(slip_law, 0.0);
@@ -808,6 +830,141 @@ TEST(Determinism, SimdGatherEqualsTheScalarReferenceBitwise) {
           << arch << " bonds without moments, column " << c;
     }
   }
+}
+
+// The gather skips the pair records the pair kernel flagged dead (GatherArgs::live): a pair that
+// neither touches nor carries a normal force has the record (0 nx + 0, 0 ny + 0, 0 nz + 0, U,
+// ny 0 - nz 0, nz 0 - nx 0, nx 0 - ny 0, 0) with U <= 0, signed zeros and all. Leaving those
+// terms out must give every column bit for bit (memcmp tells -0 from +0), on particles with
+// live and dead pairs, with only dead ones, and with bonds after; and a flag must be obeyed (a
+// live record marked dead is left out).
+TEST(Determinism, GatherSkipsDeadPairRecordsBitwise) {
+  const std::size_t n = 600, count = 2400;
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> u(-1, 1);
+  auto list = [&](std::size_t width, std::vector<std::int64_t>& a, std::vector<std::int64_t>& b,
+                  detail::Incidence& inc, std::vector<double, AlignedAllocator<double>>& rec) {
+    std::vector<std::pair<std::int64_t, std::int64_t>> ab(count);
+    for (auto& [i, j] : ab) {
+      i = std::int64_t(rng() % (n - 1));
+      j = std::int64_t(i + 1 + rng() % 40) % std::int64_t(n);
+      if (j <= i) j = i + 1;
+    }
+    std::sort(ab.begin(), ab.end());
+    for (auto [i, j] : ab) a.push_back(i), b.push_back(j);
+    detail::build_incidence(n, a.data(), b.data(), count, inc);
+    rec.assign(width * count, 0.0);
+    for (std::size_t k = 0; k < count; ++k)
+      for (std::size_t j = 0; j < width; ++j) rec[width * k + j] = u(rng);
+  };
+  std::vector<std::int64_t> pa, pb, ba, bb;
+  detail::Incidence pinc, binc;
+  std::vector<double, AlignedAllocator<double>> prec, brec;
+  list(8, pa, pb, pinc, prec);
+  list(12, ba, bb, binc, brec);
+  std::vector<std::uint8_t> live(count);
+  std::size_t dead = 0;
+  for (std::size_t k = 0; k < count; ++k) {
+    double* r = &prec[8 * k];
+    // Live: touching (U > 0); dead: the kernel's record of a near miss (fn = +0, Fs = +0).
+    live[k] = (pa[k] % 7 == 0) || rng() % 10 == 0;  // every pair of some particles is live
+    const double nx = u(rng), ny = u(rng), nz = u(rng), fn = live[k] ? 0.5 + u(rng) : 0.0;
+    const double fx = live[k] ? u(rng) : 0.0, fy = live[k] ? u(rng) : 0.0, fz = live[k] ? u(rng) : 0.0;
+    const double U = live[k] ? 1e-5 * (1.5 + u(rng)) : -1e-5 * (1.5 + u(rng));
+    const double v[8] = {fn * nx + fx, fn * ny + fy, fn * nz + fz, U,
+                         ny * fz - nz * fy, nz * fx - nx * fz, nx * fy - ny * fx, fn};
+    std::copy(v, v + 8, r);
+    dead += !live[k];
+  }
+  ASSERT_GT(dead, count / 2);
+  std::vector<double> radius(n);
+  for (auto& r : radius) r = 5e-4 * (1 + 0.3 * u(rng));
+  using Columns = std::array<std::vector<double>, 6>;
+  auto run = [&](const kernels::KernelSet& ks, const std::uint8_t* flags, bool with_bonds) {
+    Columns o;
+    for (auto& c : o) c.assign(n, -7.0);
+    kernels::GatherArgs g{pinc.start.data(), pinc.entry.data(), prec.data(), radius.data(),
+                          nullptr, nullptr, o[0].data(), o[1].data(), o[2].data(),
+                          o[3].data(), o[4].data(), o[5].data()};
+    g.live = flags;
+    kernels::GatherArgs gb = g;
+    gb.live = nullptr;
+    gb.start = binc.start.data();
+    gb.entry = binc.entry.data();
+    gb.records = brec.data();
+    ks.gather(g, with_bonds ? &gb : nullptr, 0, n);
+    return o;
+  };
+  std::size_t only_dead = 0, mixed = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::size_t l = 0, d = 0;
+    for (std::int32_t e = pinc.start[i]; e < pinc.start[i + 1]; ++e) (live[std::size_t(pinc.entry[e] >> 1)] ? l : d)++;
+    only_dead += d > 0 && l == 0;
+    mixed += d > 0 && l > 0;
+  }
+  EXPECT_GT(only_dead, 10u);
+  EXPECT_GT(mixed, 100u);
+  std::vector<const kernels::KernelSet*> sets{&kernels::scalar_kernels()};
+  for (const auto& arch : available_simd_architectures()) sets.push_back(&kernels::select_kernels(arch));
+  std::vector<std::uint8_t> wrong = live;
+  std::size_t flipped = 0;
+  for (std::size_t k = 0; k < count && flipped < 5; ++k)
+    if (live[k]) wrong[k] = 0, ++flipped;
+  for (const kernels::KernelSet* ks : sets)
+    for (bool with_bonds : {false, true}) {
+      const Columns all = run(*ks, nullptr, with_bonds), skipped = run(*ks, live.data(), with_bonds);
+      for (int c = 0; c < 6; ++c)
+        EXPECT_EQ(0, std::memcmp(all[c].data(), skipped[c].data(), n * sizeof(double)))
+            << ks->name << (with_bonds ? " with bonds" : "") << " column " << c;
+      const Columns off = run(*ks, wrong.data(), with_bonds);
+      EXPECT_NE(0, std::memcmp(all[0].data(), off[0].data(), n * sizeof(double))) << ks->name;
+    }
+}
+
+// The same on a whole run: a bonded box (its listed pairs mostly near misses, and contacts left
+// by breaking stress-free bonds, with rest overlaps) stepped once with the live flags written and
+// the dead records skipped at every step, once with them only at the probing steps (every 64th,
+// kernels/pairs.cpp), gives the same positions bit for bit and the same breaks; left to itself
+// the engine finds the box sparse and skips.
+TEST(Determinism, SkippingDeadPairRecordsLeavesARunBitwiseTheSame) {
+  struct Result {
+    std::vector<double> positions;
+    std::size_t breaks = 0, flagged_steps = 0, live = 0, pairs = 0;
+  };
+  auto run = [](int mode) {  // 0: automatic, 1: flags every step, 2: only when probing
+    WorldSettings ws;
+    ws.dt = 5e-4;
+    World w = test::random_box(600, ws);
+    w.cycle(3000);  // settle
+    BondMaterial bm;
+    bm.tensile_strength = 0.05;
+    w.install_bonds(bm, 2e-5, {}, true);
+    Result r;
+    for (int k = 0; k < 2000; ++k) {
+      if (mode > 0) {
+        w.state().pair_records_sparse = mode == 1;
+        w.state().pairs.live_counted = false;
+      }
+      w.cycle(1);
+      r.flagged_steps += w.state().pairs.live_written;
+    }
+    const detail::PairStore& q = w.state().pairs;
+    for (std::size_t k = 0; k < q.n; ++k) r.live += q.live[k];
+    r.pairs = q.n;
+    r.positions = w.positions();
+    r.breaks = w.break_events().size();
+    return r;
+  };
+  const Result every = run(1), probing = run(2), automatic = run(0);
+  // Read after the step: a step that broke bonds has merged their pairs into a new store by then.
+  EXPECT_GE(every.flagged_steps, 2000u - every.breaks);
+  EXPECT_LE(probing.flagged_steps, 2000u / 64 + 1);
+  EXPECT_GT(automatic.flagged_steps, 1900u) << "the box is found sparse";
+  EXPECT_LT(2 * every.live, every.pairs) << "most listed pairs are near misses";
+  EXPECT_GT(every.breaks, 0u);
+  EXPECT_EQ(every.breaks, probing.breaks);
+  for (const Result* r : {&probing, &automatic})
+    EXPECT_EQ(0, std::memcmp(every.positions.data(), r->positions.data(), every.positions.size() * sizeof(double)));
 }
 
 TEST(Determinism, WholeRunSameWithEveryArchitecture) {
