@@ -22,7 +22,7 @@ inline bool gather_skips(const GatherArgs& g, std::size_t i) {
   return (g.inert && g.inert[i]) || (g.idle && g.idle[i]);
 }
 
-// A pair whose stage wrote only zeros but its overlap (GatherArgs::live).
+// A pair whose record the pair kernel flagged dead: zeros but for its overlap (GatherArgs::live).
 inline bool skips_record(const GatherArgs& g, std::int64_t entry) {
   return g.live && !g.live[std::size_t(entry >> 1)];
 }
