@@ -40,6 +40,11 @@ struct PairKernelArgs {
   // overlap U <= 0: the pair touches, carries a normal force or has a NaN overlap; else 0 (the
   // gather skips those: GatherArgs::live).
   std::uint8_t* live = nullptr;
+  // With `live`: the flags it holds on entry are the last step's, and a batch dead then and now
+  // keeps its records, which are dead records already (zero forces, an overlap U <= 0 from the
+  // step it was last written; store/pairs.hpp): nothing reads them in the step (the gather
+  // skips them) and every reader outside it asks only whether U > 0.
+  bool keep_dead_records = false;
 };
 
 using PairKernel = double (*)(const PairKernelArgs&, std::size_t begin, std::size_t end);

@@ -11,20 +11,32 @@
 
 namespace asperity::kernels {
 
+// Whether the n flags from p are all 0 (PairKernelArgs::live).
+inline bool all_dead(const std::uint8_t* p, std::size_t n) {
+  unsigned any = 0;
+  for (std::size_t j = 0; j < n; ++j) any |= p[j];
+  return any == 0;
+}
+
 // Every store of batch i: the history (normal, shear force), the rest overlap, and the record.
 // A pair's record is "live" where it is not all zeros but for the overlap: the pair touches
 // (U > 0), carries a normal force (a broken bond's contact whose rest overlap U0 < 0 pushes
 // within U0 < U <= 0) or has no valid overlap (NaN). Where PairKernelArgs::live is given, its
-// flag goes there and `live` counts them per lane (PairKernelArgs::touched).
+// flag goes there and `live` counts them per lane (PairKernelArgs::touched). A batch whose pairs
+// were all dead in the last step and are now leaves its records as they are
+// (PairKernelArgs::keep_dead_records).
 template <class Lanes, class T = typename Lanes::Real>
 inline void store_pair(const PairKernelArgs& k, std::size_t i, const T& nx, const T& ny,
                        const T& nz, const T& U, const T& u0, const T& fx, const T& fy, const T& fz,
                        const T& fn, T& live) {
+  bool keep_record = false;
   if (k.live) {
     T lanes = select(U <= T(0.0), T(0.0), T(1.0));
     lanes = select(fn != T(0.0), T(1.0), lanes);
+    const bool was_dead = k.keep_dead_records && all_dead(k.live + i, Lanes::size);
     Lanes::store_flags(k.live + i, lanes);
     live = live + lanes;
+    keep_record = was_dead && !any(lanes != T(0.0));
   }
   // A pair that no longer touches forgets its rest overlap with its shear force.
   if (k.rest) Lanes::store(k.rest + i, select(U > T(0.0), u0, T(0.0)));
@@ -33,6 +45,7 @@ inline void store_pair(const PairKernelArgs& k, std::size_t i, const T& nx, cons
   // For the gather (kernels/integrate.cpp), with the operations it would do per side, and for
   // the readers of fn and U: the record fx fy fz U cx cy cz fn of each pair (store/pairs.hpp).
   // fn and U have no columns of their own to store to.
+  if (keep_record) return;
   const T record[8] = {fn * nx + fx, fn * ny + fy, fn * nz + fz, U,
                        ny * fz - nz * fy, nz * fx - nx * fz, nx * fy - ny * fx, fn};
   if (k.stream)  // large record arrays (kernels.hpp)

@@ -26,7 +26,10 @@ struct PairStore {
   AVec<double> fsx, fsy, fsz;  // shear force on b (history)
   // Normal force on b along n (>= 0) and overlap U = Ra + Rb - d (negative: not touching), as the
   // neighbour build or a checkpoint set them; after a step they are in the records
-  // (outputs_in_records): read them through normal_force(k) and overlap_at(k).
+  // (outputs_in_records): read them through normal_force(k) and overlap_at(k). A pair that has
+  // neither touched nor carried a force for two steps or more may keep an older record (kernels.hpp,
+  // PairKernelArgs::keep_dead_records): fn 0 as now, but for U the gap (<= 0) of the step that
+  // wrote it, not the current one. Every reader asks only whether U > 0.
   AVec<double> fn;
   AVec<double> overlap;
   // Rest overlap (history): the overlap at which the normal spring is unloaded, Fn = kn (U - rest)
@@ -49,6 +52,7 @@ struct PairStore {
   // kernel where live_written (kernels.hpp, PairKernelArgs::live) for the gather in the same step.
   std::vector<std::uint8_t> live;
   bool live_written = false;  // this step's pair kernel writes `live` (kernels/pairs.cpp)
+  bool live_current = false;  // `live` holds the flags of the last pair kernel's run
   bool live_counted = false;  // `touched` holds the last pair kernel's counts of live records
   // Set by the pair stage: the current normal forces and overlaps are in the records (slots 7
   // and 3), the fn and overlap columns are stale. Cleared where the columns are written.
@@ -83,6 +87,7 @@ struct PairStore {
     touched.assign(padded / kTouchStage + 1, 1);
     live.assign(padded, 1);
     live_counted = false;
+    live_current = false;
     outputs_in_records = false;
   }
   // Padding entries: pair of two null particles, unit normal along x, no force.
