@@ -100,7 +100,8 @@ StageLoop pair_stage(State& s) {
   q.live_counted = q.live_written;
   if (!q.live_written) args.live = nullptr;
   // A batch of pairs dead in the last step and in this one keeps its records (thesis-scale joint:
-  // 0.90-0.93 of the step): only where the flags are the last step's.
+  // 0.84-0.90 of the step in one process, perf/README.md): only where the flags are the last
+  // step's.
   args.keep_dead_records = q.live_written && q.live_current;
   q.live_current = q.live_written;
   const std::size_t total = s.pairs.padded;
