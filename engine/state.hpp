@@ -99,7 +99,7 @@ struct State {
   ParticleStore p;
   PairStore pairs;
   // Fewer than half the pair records were live when the pair kernel last counted them
-  // (PairStore::live_counted): the kernel flags them and the gather skips the dead ones
+  // (PairStore::live_current): the kernel flags them and the gather skips the dead ones
   // (kernels/pairs.cpp). Kept here: a neighbour build replaces the pair store.
   bool pair_records_sparse = false;
   Incidence incidence;

@@ -91,16 +91,15 @@ StageLoop pair_stage(State& s) {
   // the step and save nothing, so a step counts them only every 64th step, to notice a change.
   // Neither choice changes a bit of the results.
   PairStore& q = s.pairs;
-  if (q.live_counted) {
+  if (q.live_current) {
     std::size_t live = 0;
     for (const std::uint8_t t : q.touched) live += t;
     s.pair_records_sparse = 2 * live < q.n;
   }
   q.live_written = s.pair_records_sparse || s.step % 64 == 0;
-  q.live_counted = q.live_written;
   if (!q.live_written) args.live = nullptr;
   // A batch of pairs dead in the last step and in this one keeps its records (thesis-scale joint:
-  // 0.84-0.90 of the step in one process, perf/README.md): only where the flags are the last
+  // 0.97-0.99 of the step in one process, perf/README.md): only where the flags are the last
   // step's.
   args.keep_dead_records = q.live_written && q.live_current;
   q.live_current = q.live_written;

@@ -604,12 +604,7 @@ TEST(Bonds, BondedBlockIsDeterministicAcrossThreadsAndSurvivesReorders) {
     WorldSettings ws;
     ws.threads = threads;
     ws.reorder_interval = reorder;
-    ws.dt = 5e-4;
-    World w = test::random_box(600, ws);
-    w.cycle(3000);  // settle
-    BondMaterial bm;
-    bm.tensile_strength = 0.05;
-    w.install_bonds(bm, 2e-5, {}, stress_free);
+    World w = test::bonded_box(ws, stress_free);
     w.cycle(2000);
     return std::make_pair(w.positions(), w.break_events().size());
   };

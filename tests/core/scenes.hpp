@@ -71,4 +71,16 @@ inline World random_box(int n, WorldSettings ws = {}, unsigned seed = 1, double 
   return w;
 }
 
+// random_box(600) settled, then bonded with a strength low enough that bonds break as it goes on
+// (more of them when installed stress-free: their contacts keep rest overlaps). dt 5e-4.
+inline World bonded_box(WorldSettings ws, bool stress_free) {
+  ws.dt = 5e-4;
+  World w = random_box(600, ws);
+  w.cycle(3000);  // settle
+  BondMaterial bm;
+  bm.tensile_strength = 0.05;
+  w.install_bonds(bm, 2e-5, {}, stress_free);
+  return w;
+}
+
 }  // namespace asperity::test
