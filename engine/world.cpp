@@ -107,6 +107,8 @@ World::World(WorldSettings settings) : state_(std::make_unique<State>()) {
   require(settings.dt_interval >= 1, "dt_interval must be >= 1");
   require(settings.threads >= 0, "threads must be >= 0 (0: all cores)");
   require(settings.reorder_interval >= 0, "reorder_interval must be >= 0");
+  require(settings.rotation_lock_bonds >= 1,
+          "rotation_lock_bonds must be >= 1, got " + std::to_string(settings.rotation_lock_bonds));
   require_finite(settings.gravity, "gravity");
   s.kernels = &kernels::select_kernels(settings.simd);
   s.max_threads = omp_get_max_threads();

@@ -1,82 +1,143 @@
--- Calibration of the bond tensile strength [thesis 3.3.2; scenarios.md 2.5]: find the bond
+-- Calibration of the bonded material on the REV [thesis 3.3.2; scenarios.md 2.5]: the bond
 -- strength st of the elliptic criterion for which the REV's tensile strength, scaled to rock by
--- E_exp / E_REV [3-37], equals the target (Table 3-1: 6.6 MPa).
+-- E_exp / E_REV [3-37] and averaged over several packings (seeds), equals the target (Table 3-1:
+-- 6.6 MPa); then the compressive strength, E, nu and their isotropy at that st, with the scatter
+-- over the packings.
 --
---   build/asperity run scripts/calibrate_rev.lua                      # out/calibration/
---   build/asperity run scripts/calibrate_rev.lua target_mpa=6.6 seed=2 compression=true
+--   build/asperity run scripts/calibrate_rev.lua                               # out/calibration/
+--   build/asperity run scripts/calibrate_rev.lua seeds=1,2,3,4 bond_shear_ratio=0.3 rotation_lock_bonds=3
 --
--- Each evaluation runs scripts/rev.lua (packing, bonding, wall removal, elastic test for E_REV,
--- tension to failure) with the trial st. The REV tensile strength is close to proportional to st
--- (the packing, E_REV and the internal bond stresses do not depend on it), so the next trial is
--- st * target / measured, a secant through the origin; it stops within `tolerance`. The search
--- starts above the strength every bond needs to survive the wall removal (rev.lua reports it):
--- below that, bonds break before any test and the REV is not the material being calibrated.
--- With compression=true the final st is also tested in compression (sc, sc/st).
--- Writes out/summary.json (the trials and the result) and prints the line to put into
--- scripts/lib/materials.lua.
+-- The other micro-parameters (bond_shear_ratio, bond_radius_factor, rotation_lock_bonds,
+-- bond_gap, genesis_stress, porosity) are passed to rev.lua; materials.lua's are the defaults.
+-- Each packing is made once (rev.lua's cache). The REV tensile strength is proportional to st
+-- while no bond breaks before the test (E_REV and the bond stresses the genesis leaves do not
+-- depend on st), so the next trial is st * target / measured; it stops within `tolerance`.
+-- Writes out/summary.json (trials, per-seed results, means and standard deviations) and prints the
+-- line to put into scripts/lib/materials.lua.
 local mat = require("materials")
 local P = require("params").defaults{
   target_mpa = mat.rock.tensile_strength / 1e6,
   start = 0,                              -- Pa, first trial st (0: the calibrated one of materials.lua)
-  tolerance = 0.01,                       -- relative, on the scaled tensile strength
-  iterations = 8,
-  seed = 1,
-  compression = false,
-  packing_stress = -1,                    -- Pa, passed to rev.lua (0: bond as packed; < 0: materials.lua's)
-  stress_free_bonds = false,              -- passed to rev.lua
+  tolerance = 0.01,                       -- relative, on the mean scaled tensile strength
+  iterations = 6,
+  seeds = "1,2,3",                        -- packings averaged
+  compression = true,                     -- also test the calibrated st in compression
+  isotropy = true,                        -- also E and nu along x and y
+  bond_shear_ratio = mat.rev.bond_shear_ratio,
+  bond_radius_factor = mat.rev.bond_radius_factor,
+  rotation_lock_bonds = mat.rev.rotation_lock_bonds,
+  bond_gap = 0,
+  genesis_stress = mat.genesis.stress,
+  porosity = mat.genesis.porosity,
   out = "out/calibration",
+  cache = "",                             -- packings cached here (default out/cache)
 }
-local rev_material = mat.rev_for(P.stress_free_bonds)
-if P.start <= 0 then P.start = rev_material.bond_tensile_strength end
-if P.packing_stress < 0 then P.packing_stress = rev_material.packing_stress end
+if P.start <= 0 then P.start = mat.rev.bond_tensile_strength end
 local out = asperity.mkdir(P.out)
+local cache = P.cache ~= "" and P.cache or out .. "/cache"
+local seeds = {}
+for s in P.seeds:gmatch("[^,%s]+") do
+  local v = math.tointeger(tonumber(s))
+  if not v or v < 1 then error(("seeds: '%s' is not a positive integer (give e.g. seeds=1,2,3)"):format(s)) end
+  seeds[#seeds + 1] = v
+end
+if #seeds == 0 then error("seeds: give at least one seed (e.g. seeds=1,2,3)") end
 local rev_script = asperity.scripts_dir .. "/rev.lua"
 
-local function rev(st, tests, k)
-  params = {tensile_strength = st, tests = tests, seed = P.seed, packing_stress = P.packing_stress,
-            stress_free_bonds = P.stress_free_bonds, out = ("%s/trial_%02d"):format(out, k)}
+local function rev(st, tests, seed, name)
+  params = {tensile_strength = st, tests = tests, seed = seed, cache = cache,
+            bond_shear_ratio = P.bond_shear_ratio, bond_radius_factor = P.bond_radius_factor,
+            rotation_lock_bonds = P.rotation_lock_bonds, bond_gap = P.bond_gap,
+            genesis_stress = P.genesis_stress, porosity = P.porosity,
+            out = ("%s/%s_seed%d"):format(out, name, seed)}
   return dofile(rev_script)
+end
+
+local function stats(list, key)
+  local n, s, s2 = 0, 0, 0
+  for _, r in ipairs(list) do
+    local v = r[key]
+    if v then n, s, s2 = n + 1, s + v, s2 + v * v end
+  end
+  if n == 0 then return nil end
+  local m = s / n
+  return {mean = m, sd = n > 1 and math.sqrt(math.max(0, (s2 - n * m * m) / (n - 1))) or 0, n = n}
 end
 
 local trials = {}
 local st = P.start
 local result
 for k = 1, P.iterations do
-  local s = rev(st, "elastic,tension", k)
-  local floor = s.residual_bond_stress.strength_to_hold_max_pa
-  local measured = s.tensile_strength_mpa
-  trials[#trials + 1] = {bond_tensile_strength_pa = st, tensile_strength_mpa = measured,
-                         tensile_strength_pa = s.tensile_strength_pa, young_modulus_pa = s.young_modulus_pa,
-                         strength_to_hold_max_pa = floor}
-  print(("trial %d: st = %.5g Pa -> REV tensile strength %.4g Pa = %.3f MPa (E_REV %.4g Pa); target %.3f MPa")
-        :format(k, st, s.tensile_strength_pa, measured, s.young_modulus_pa, P.target_mpa))
-  if math.abs(measured / P.target_mpa - 1) <= P.tolerance then
-    result = {bond_tensile_strength_pa = st, young_modulus_pa = s.young_modulus_pa,
-              tensile_strength_mpa = measured, strength_to_hold_max_pa = floor}
+  local per_seed = {}
+  for _, seed in ipairs(seeds) do
+    local s = rev(st, "elastic,tension", seed, ("trial%02d"):format(k))
+    per_seed[#per_seed + 1] = {seed = seed, tensile_strength_mpa = s.tensile_strength_mpa,
+                               young_modulus_pa = s.young_modulus_pa, poisson_ratio = s.poisson_ratio,
+                               broken_in_relaxation = s.broken_in_relaxation,
+                               bond_stress_max_over_st = s.bond_stress_max_over_st}
+  end
+  local t = stats(per_seed, "tensile_strength_mpa")
+  trials[#trials + 1] = {bond_tensile_strength_pa = st, tensile_strength_mpa = t, per_seed = per_seed}
+  print(("trial %d: st = %.5g Pa -> REV tensile strength %.3f +- %.3f MPa over %d packings; target %.3f MPa")
+        :format(k, st, t.mean, t.sd, t.n, P.target_mpa))
+  if math.abs(t.mean / P.target_mpa - 1) <= P.tolerance then
+    result = {bond_tensile_strength_pa = st, tensile_strength_mpa = t}
     break
   end
-  local next_st = st * P.target_mpa / measured
-  if next_st <= floor then
-    error(("calibrate_rev: the target needs st = %.4g Pa, below the %.4g Pa some bonds need to survive " ..
-           "the wall removal; lower the packing stress or raise the target"):format(next_st, floor))
-  end
-  st = next_st
+  st = st * P.target_mpa / t.mean
 end
 if not result then
   error(("calibrate_rev: no st within %.0f %% of %.3f MPa after %d trials (see %s/summary.json)")
         :format(100 * P.tolerance, P.target_mpa, P.iterations, out))
 end
-if P.compression then
-  local s = rev(result.bond_tensile_strength_pa, "elastic,compression,tension", #trials + 1)
-  result.compressive_strength_mpa = s.compressive_strength_mpa
-  result.tensile_strength_mpa_check = s.tensile_strength_mpa
-  result.strength_ratio = s.strength_ratio
-  print(("compression at the calibrated st: %.2f MPa (Table 3-1: %.1f MPa), sc/st = %.2f")
-        :format(s.compressive_strength_mpa, mat.rock.compressive_strength / 1e6, s.strength_ratio))
+
+-- The calibrated st on every packing: all tests asked for.
+local tests = "elastic,tension" .. (P.compression and ",compression" or "") .. (P.isotropy and ",isotropy" or "")
+local finals = {}
+for _, seed in ipairs(seeds) do
+  local s = rev(result.bond_tensile_strength_pa, tests, seed, "final")
+  local e, nu = s.young_modulus_by_axis_pa, s.poisson_ratio_by_axis
+  finals[#finals + 1] = {seed = seed, young_modulus_pa = s.young_modulus_pa, poisson_ratio = s.poisson_ratio,
+                         tensile_strength_mpa = s.tensile_strength_mpa, compressive_strength_mpa = s.compressive_strength_mpa,
+                         strength_ratio = s.strength_ratio, young_modulus_spread = s.young_modulus_spread,
+                         poisson_ratio_spread = s.poisson_ratio_spread,
+                         young_modulus_x = e and e.x, young_modulus_y = e and e.y, young_modulus_z = e and e.z,
+                         poisson_ratio_x = nu and nu.x, poisson_ratio_y = nu and nu.y, poisson_ratio_z = nu and nu.z,
+                         bond_stress_max_over_st = s.bond_stress_max_over_st,
+                         bonds_broken_in_relaxation = s.bonds_broken_in_relaxation,
+                         particles = s.n_particles, bonds_per_particle = s.bonds_per_particle,
+                         porosity_nominal = s.porosity_nominal, porosity_true = s.porosity_true}
 end
+for _, key in ipairs{"young_modulus_pa", "poisson_ratio", "tensile_strength_mpa", "compressive_strength_mpa",
+                     "strength_ratio", "young_modulus_spread", "poisson_ratio_spread", "bond_stress_max_over_st",
+                     "young_modulus_x", "young_modulus_y", "young_modulus_z", "poisson_ratio_x", "poisson_ratio_y",
+                     "poisson_ratio_z", "bonds_per_particle", "porosity_nominal", "porosity_true"} do
+  result[key] = stats(finals, key)
+end
+-- Isotropy over the packings: the means along x, y and z (each packing alone is noisier).
+if P.isotropy then
+  local function spread(a, b, c)
+    local m = (a + b + c) / 3
+    return (math.max(a, b, c) - math.min(a, b, c)) / m
+  end
+  result.young_modulus_spread_of_means = spread(result.young_modulus_x.mean, result.young_modulus_y.mean,
+                                                result.young_modulus_z.mean)
+  result.poisson_ratio_spread_of_means = spread(result.poisson_ratio_x.mean, result.poisson_ratio_y.mean,
+                                                result.poisson_ratio_z.mean)
+end
+result.per_seed = finals
 asperity.write_json(out .. "/summary.json", {parameters = P, trials = trials, result = result})
-print(("calibrated: bond_tensile_strength = %.5g Pa (E_REV = %.5g Pa, REV tensile strength %.3f MPa " ..
-       "scaled) after %d trials; put it in scripts/lib/materials.lua (%s)")
-      :format(result.bond_tensile_strength_pa, result.young_modulus_pa, result.tensile_strength_mpa, #trials,
-              P.stress_free_bonds and "M.rev_stress_free" or "M.rev"))
+local function ms(t, fmt) return t and (fmt .. " +- " .. fmt):format(t.mean, t.sd) or "-" end
+print(("calibrated over %d packings: st = %.5g Pa; E_REV %s Pa, nu %s, tensile %s MPa, compressive %s MPa, sc/st %s")
+      :format(#seeds, result.bond_tensile_strength_pa, ms(result.young_modulus_pa, "%.4g"), ms(result.poisson_ratio, "%.3f"),
+              ms(result.tensile_strength_mpa, "%.2f"), ms(result.compressive_strength_mpa, "%.1f"),
+              ms(result.strength_ratio, "%.2f")))
+if P.isotropy then
+  print(("isotropy: E x/y/z %.4g / %.4g / %.4g Pa (spread of the means %.1f %%), nu %.3f / %.3f / %.3f (%.1f %%)")
+        :format(result.young_modulus_x.mean, result.young_modulus_y.mean, result.young_modulus_z.mean,
+                100 * result.young_modulus_spread_of_means, result.poisson_ratio_x.mean, result.poisson_ratio_y.mean,
+                result.poisson_ratio_z.mean, 100 * result.poisson_ratio_spread_of_means))
+end
+print(("put into scripts/lib/materials.lua M.rev: young_modulus = %.5g, bond_tensile_strength = %.5g")
+      :format(result.young_modulus_pa.mean, result.bond_tensile_strength_pa))
 return result

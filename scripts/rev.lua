@@ -33,18 +33,22 @@ local pack = require("pack")
 local walls = require("walls")
 local eq = require("equilibrium")
 local specimen = require("specimen")
+local genesis = require("genesis")
 local figures = require("figures")
 
 -- The calibrated material of the chosen bond installation (scripts/lib/materials.lua) supplies
 -- the defaults of st and the packing stress.
-local rev = mat.rev_for(params ~= nil and params.stress_free_bonds == true)
+local rev = mat.rev
 local P = require("params").defaults{
-  size = 0.01, porosity = mat.packing.porosity, seed = 1,
+  size = 0.01, porosity = mat.genesis.porosity, seed = 1,
   mean_radius = mat.packing.mean_radius, radius_sd = mat.packing.radius_sd,
   kn = mat.contact.kn, ks = mat.contact.ks, friction = mat.contact.friction,
   damping = mat.damping, density = mat.density,
+  genesis_stress = mat.genesis.stress,           -- Pa, isotropic stress the genesis installs before bonding
+  floater_contacts = mat.genesis.floater_contacts, -- particles with fewer contacts are taken out
   tensile_strength = rev.bond_tensile_strength,  -- Pa, bond st (elliptic criterion)
-  packing_stress = rev.packing_stress,           -- Pa, wall stress before bonding; 0: as packed
+  bond_shear_ratio = rev.bond_shear_ratio,       -- kbs / kbn of the parallel bonds
+  bond_radius_factor = rev.bond_radius_factor,   -- lambda: Rb = lambda min(Ra, Rb) [3-26]
   rate = 1e-6,               -- m/s, platen velocity (thesis: 1 um/s)
   elastic_strain = 2e-4,     -- strain reached in the elastic tests
   stop_fraction = 0.7,       -- fracture tests stop when |stress| < this x peak (after the peak)
@@ -52,13 +56,13 @@ local P = require("params").defaults{
   platen = 1e-3,             -- m, platen thickness (particles within it of the face)
   ratio = 1e-4,              -- equilibrium: mean unbalanced / mean contact force
   every = 100,               -- steps between recorded rows
-  tests = "elastic,shear,compression,tension",   -- which tests to run
+  tests = "elastic,isotropy,shear,compression,tension",   -- which tests to run
   rate_check = false,
   lock_rotation = true,      -- model.md 2: bonded particles do not rotate
+  rotation_lock_bonds = rev.rotation_lock_bonds, -- ... while they hold at least this many intact bonds
   bond_gap = 0,              -- m, largest gap bonded (0: the engine's default, 1e-3 x mean radius)
-  stress_free_bonds = rev.stress_free_bonds, -- true: each contact bond unloaded at its installed overlap (not model.md 5's
-                             -- "existing contact forces are kept"; scripts/README.md, "Stress-free bonds")
   dt_safety = 0,             -- time step / critical estimate in the tests (0: the engine's 0.8)
+  cache = "",                -- a folder: the packing is cached there and reused (calibrate_rev.lua)
   threads = 1,
   simd = "auto",             -- kernels of bonding and tests: auto, an architecture, or "float" (the force laws
                              -- in single precision, scalar: perf/runtime_vs_error.lua's study); packing: auto
@@ -67,12 +71,12 @@ local P = require("params").defaults{
 local out = asperity.mkdir(P.out)
 local want = {}
 for name in P.tests:gmatch("[^,%s]+") do
-  if not ({elastic = true, shear = true, compression = true, tension = true})[name] then
-    error("tests: unknown test '" .. name .. "' (elastic, shear, compression, tension)")
+  if not ({elastic = true, shear = true, compression = true, tension = true, isotropy = true})[name] then
+    error("tests: unknown test '" .. name .. "' (elastic, isotropy, shear, compression, tension)")
   end
   want[name] = true
 end
-want.elastic = want.elastic or want.shear   -- the shear test compares with E and nu
+want.elastic = want.elastic or want.shear or want.isotropy  -- shear and isotropy compare with E and nu
 local L = P.size
 local area = L * L
 local clock0 = asperity.wall_time()
@@ -87,10 +91,11 @@ local function log(fmt, ...) io.write((fmt .. "\n"):format(...)); io.flush() end
 
 local function new_world()
   return asperity.world{material = {kn = P.kn, ks = P.ks, friction = P.friction}, damping = P.damping,
-                        density = P.density, threads = P.threads, lock_bonded_rotation = P.lock_rotation}
+                        density = P.density, threads = P.threads, lock_bonded_rotation = P.lock_rotation,
+                        rotation_lock_bonds = P.rotation_lock_bonds}
 end
 
--- 1. Packing --------------------------------------------------------------------------------------
+-- 1. Genesis [scenarios.md 1] ---------------------------------------------------------------------
 local function make_packing()
   local w = new_world()
   local lo, hi = {0, 0, 0}, {L, L, L}
@@ -98,48 +103,79 @@ local function make_packing()
   local n = radii.count_for_porosity{volume = L ^ 3, porosity = P.porosity, mean_radius = P.mean_radius}
   local r = radii.truncated_gaussian{count = n, mean = P.mean_radius, sd = P.radius_sd, cut = mat.packing.cut,
                                      seed = P.seed, normalise_mean = true}
-  local res = pack.expand(w, {min = lo, max = hi, radii = r, seed = P.seed, walls = box, ratio = P.ratio})
-  log("packed %d particles in %d steps (%.1f s): wall stress %.4g Pa, coordination %.2f",
-      n, res.steps, res.seconds, res.wall_stress.top, res.coordination)
-  local info = {n_particles = n, expansion = res, wall_stress_expanded_pa = res.wall_stress}
-  if P.packing_stress > 0 then
-    local s = pack.install_stress(w, {first = res.first, last = res.last, walls = box, min = lo, max = hi,
-                                      target = P.packing_stress, ratio = P.ratio})
-    log("stress installation: radii x %.5f, wall stress %.4g Pa (target %.4g) after %d iterations",
-        s.factor, s.stress, P.packing_stress, s.iterations)
-    -- Near jamming the stress is not a continuous function of the radii: a packing that came
-    -- unjammed by a shrink does not jam again at the same density (its rattlers moved), so the
-    -- bisection can close on the jump with the target unmet. The REV is then bonded as it is
-    -- (with the stress it carries, possibly none); say so rather than pass it silently.
-    if not s.reached then
-      log("warning: the stress installation did not reach %.4g Pa (it ended at %.4g Pa): the bonds " ..
-          "are installed in that state (summary.json: stress_installation.reached = false)",
-          P.packing_stress, s.stress)
-    end
-    info.stress_installation = s
-  end
-  local rr = w:radii():flat()
-  info.porosity_nominal, info.porosity_true, info.mean_radius = radii.porosity(rr, L ^ 3)
+  local g = genesis.pack(w, {min = lo, max = hi, radii = r, seed = P.seed, box = box, stress = P.genesis_stress,
+                             friction = P.friction, ratio = P.ratio, min_contacts = P.floater_contacts,
+                             log = log})
+  local info = {n_particles = #g.kept, n_generated = n, genesis = g, box = box, kept = g.kept,
+                porosity_nominal = g.porosity_nominal, porosity_true = g.porosity_true,
+                mean_radius = g.mean_radius, coordination = g.coordination,
+                wall_stress_pa = g.wall_stress_pa}
+  local rr = {}
+  local all = w:radii()
+  for i, id in ipairs(g.kept) do rr[i] = all:get(id) end
   info.radius_stats = radii.stats(rr)
-  info.wall_stress_pa = pack.box_wall_stresses(w, box, lo, hi)
-  info.coordination = 2 * w:contact_count() / n
-  info.box = box
   w:save(out .. "/packed.h5")
   return info
 end
-local packing = timed("packing", make_packing)
+-- The packing is cached (cache=DIR): a calibration bonds the same packing with many bond parameters.
+-- Keyed by everything that shapes it; the genesis record beside it as a Lua table.
+local function cached_packing()
+  if P.cache == "" then return make_packing() end
+  asperity.mkdir(P.cache)
+  local key = ("rev_v1_L%.6g_n%.6g_s%d_r%.6g_%.6g_k%.6g_%.6g_d%.6g_%.6g_g%.6g_f%d_q%.6g"):format(P.size, P.porosity,
+    P.seed, P.mean_radius, P.radius_sd, P.kn, P.ks, P.damping, P.density, P.genesis_stress, P.floater_contacts, P.ratio)
+    .. (P.lock_rotation and ("_l%d"):format(P.rotation_lock_bonds) or "_free")
+  local h5, rec = P.cache .. "/" .. key .. ".h5", P.cache .. "/" .. key .. ".lua"
+  local f = io.open(rec, "r")
+  if f then
+    f:close()
+    local info = dofile(rec)
+    local w = asperity.load(h5, {threads = P.threads})
+    w:save(out .. "/packed.h5")
+    log("reusing the cached packing %s", h5)
+    return info
+  end
+  local info = make_packing()
+  os.rename(out .. "/packed.h5", h5 .. ".tmp")
+  os.rename(h5 .. ".tmp", h5)
+  asperity.load(h5):save(out .. "/packed.h5")
+  local tmp = rec .. ".tmp"
+  local g = assert(io.open(tmp, "w"))
+  g:write("return " .. genesis.serialise(info) .. "\n")
+  g:close()
+  os.rename(tmp, rec)
+  return info
+end
+local packing = timed("packing", cached_packing)
 
 -- 2. Bonding, wall removal, relaxation --------------------------------------------------------------
-local function bonded(material)
-  local w = asperity.load(out .. "/packed.h5", {threads = P.threads, simd = P.simd})
-  local count = w:install_bonds(material)
-  for _, id in pairs(packing.box) do w:remove_wall(id) end
-  local steps, reached, ratio = eq.run(w, {ratio = P.ratio, steps = 1000000})
-  return w, {bonds = count, relax_steps = steps, relax_reached = reached, relax_ratio = ratio,
-             broken_in_relaxation = w:break_count()}
+-- axis "x" or "y": the packing's coordinates turned (x, y, z) -> (y, z, x) or (z, x, y) before bonding,
+-- so the tests along z load the packing along x or y. Exact: the packing is a cube in a cube of
+-- walls at rest, and its contacts, frictionless until bonded, carry no shear force that would have
+-- to turn with it.
+local function turn(w, axis)
+  local pos = w:positions()
+  local from = axis == "x" and {2, 3, 1} or {3, 1, 2}
+  for _, id in ipairs(packing.kept) do   -- the floaters are out of the specimen (inert)
+    w:set_position(id, {pos:get(id, from[1]), pos:get(id, from[2]), pos:get(id, from[3])})
+    w:set_velocity(id, {0, 0, 0})
+  end
 end
 
-local bond_material = {beam_kn = P.kn, beam_ks = P.ks, radius_factor = 1, stress_free = P.stress_free_bonds}
+local function bonded(material, csv, axis)
+  local w = asperity.load(out .. "/packed.h5", {threads = P.threads, simd = P.simd})
+  if axis and axis ~= "z" then turn(w, axis) end
+  local walls_list = {}
+  for _, id in pairs(packing.box) do walls_list[#walls_list + 1] = id end
+  table.sort(walls_list, function(a, b) return a > b end)   -- removal renumbers the walls after it
+  local b = genesis.bond(w, {sets = {packing.kept}, material = material, walls = walls_list, ratio = P.ratio,
+                             tensile_strength = P.tensile_strength, csv = csv})
+  return w, {bonds = b.bonds, relax_steps = b.relax_steps, relax_reached = b.relax_reached,
+             relax_ratio = b.relax_ratio, broken_in_relaxation = b.broken_in_relaxation,
+             bond_stress = b.bond_stress}
+end
+
+local bond_material = {beam_kn = P.kn, beam_ks = P.kn * P.bond_shear_ratio, radius_factor = P.bond_radius_factor}
 if P.bond_gap > 0 then bond_material.tolerance = P.bond_gap end   -- else the engine's 1e-3 <R>
 local function with(t, extra)
   local c = {}
@@ -148,34 +184,14 @@ local function with(t, extra)
   return c
 end
 
-local welastic, elastic_info = timed("bond_relax_elastic", bonded, with(bond_material, {breakable = false}))
+local welastic, elastic_info = timed("bond_relax_elastic", bonded, with(bond_material, {breakable = false}),
+                                    out .. "/bond_stresses.csv")
 log("elastic model: %d bonds, relaxed in %d steps (ratio %.2g)", elastic_info.bonds, elastic_info.relax_steps,
     elastic_info.relax_ratio)
 
--- Bond stresses left after wall removal, and the strength each bond needs to hold.
+-- Bond stresses left after wall removal, and the strength each bond needs to hold [scenarios.md 1].
 local function residual_stresses(w)
-  local sig, tau, need = {}, {}, {}
-  local f = assert(io.open(out .. "/bond_stresses.csv", "w"))
-  f:write("a,b,sigma [Pa],tau [Pa],strength_to_hold [Pa]\n")
-  for _, b in ipairs(w:bonds()) do
-    local s = mat.strength_to_hold(b.sigma, b.tau)
-    sig[#sig + 1], tau[#tau + 1], need[#need + 1] = b.sigma, b.tau, s
-    f:write(("%d,%d,%.10g,%.10g,%.10g\n"):format(b.a, b.b, b.sigma, b.tau, s))
-  end
-  f:close()
-  local function quantile(v, q)
-    local c = {}
-    for i = 1, #v do c[i] = v[i] end
-    table.sort(c)
-    return c[math.max(1, math.ceil(q * #c))]
-  end
-  local stats = {sigma_max_pa = quantile(sig, 1), sigma_min_pa = quantile(sig, 1 / #sig),
-                 sigma_p99_pa = quantile(sig, 0.99), tau_max_pa = quantile(tau, 1),
-                 strength_to_hold_max_pa = quantile(need, 1), strength_to_hold_p99_pa = quantile(need, 0.99),
-                 strength_to_hold_p90_pa = quantile(need, 0.90), bonds = #sig}
-  local ms = 0
-  for i = 1, #sig do ms = ms + sig[i] end
-  stats.sigma_mean_pa = ms / #sig
+  local stats, sig, need = genesis.bond_stresses(w, P.tensile_strength)
   figures.histogram{file = out .. "/bond_stresses_sigma.png", values = sig, bins = 50,
                     xlabel = "sigma [Pa]", csv = out .. "/bond_stresses_sigma_hist.csv",
                     title = "Bond normal stress after wall removal (tension +)",
@@ -183,18 +199,22 @@ local function residual_stresses(w)
   figures.histogram{file = out .. "/bond_stresses_strength.png", values = need, bins = 50, min = 0,
                     xlabel = "strength to hold [Pa]", csv = out .. "/bond_stresses_strength_hist.csv",
                     title = "Bond strength each bond needs after wall removal (elliptic criterion)",
-                    marks = {{x = P.tensile_strength, label = "st"}}}
+                    marks = {{x = P.tensile_strength, label = "st"}, {x = P.tensile_strength / 3, label = "st/3"}}}
   return stats
 end
 local residual = residual_stresses(welastic)
-log("bond stresses after wall removal: sigma %.3g .. %.3g Pa, strength to hold max %.3g Pa (p99 %.3g)",
-    residual.sigma_min_pa, residual.sigma_max_pa, residual.strength_to_hold_max_pa, residual.strength_to_hold_p99_pa)
+log("bond stresses after wall removal: sigma %.3g .. %.3g Pa, strength to hold max %.3g Pa = %.3f st (p99 %.3g)",
+    residual.sigma_min_pa, residual.sigma_max_pa, residual.strength_to_hold_max_pa, residual.max_over_st,
+    residual.strength_to_hold_p99_pa)
 
 -- 3. Platens and gauges -------------------------------------------------------------------------------
+local rigs = {}   -- checkpoint name -> {platens, gauges}
 local function prepare(w, name)
-  local pl = specimen.platens(w, {thickness = P.platen})
-  local g = specimen.gauges(w, {platens = pl})
+  local ext = specimen.extent(w, packing.kept)
+  local pl = specimen.platens(w, {thickness = P.platen, ids = packing.kept, extent = ext})
+  local g = specimen.gauges(w, {platens = pl, extent = ext})
   w:save(out .. "/" .. name .. ".h5")
+  rigs[name] = {platens = pl, gauges = g}
   return pl, g
 end
 local platens, gauges = prepare(welastic, "elastic")
@@ -214,6 +234,7 @@ local columns = {"step", "time [s]", "displacement [m]", "axial_stress [Pa]", "s
                  "slab_xz [Pa]", "slab_zx [Pa]"}
 local function run_test(checkpoint, name, velocity, o)
   local t0 = asperity.wall_time()
+  local platens, gauges = rigs[checkpoint].platens, rigs[checkpoint].gauges
   local w = asperity.load(out .. "/" .. checkpoint .. ".h5", {threads = P.threads, simd = P.simd})
   if P.dt_safety > 0 then w:set_dt_safety(P.dt_safety) end
   local meter = specimen.strain_meter(w, gauges)
@@ -266,8 +287,8 @@ local function fit(series, xname, yname, strain_name)
   return specimen.fit_line(x, y, function(i) return math.abs(e[i]) >= 0.2 * emax end)
 end
 
-local function elastic_axial(name, sign)
-  local r = run_test("elastic", name, {0, 0, sign * P.rate}, {slab = true,
+local function elastic_axial(name, sign, checkpoint)
+  local r = run_test(checkpoint or "elastic", name, {0, 0, sign * P.rate}, {slab = true,
     value = function(row) return row.axial_stress end,
     stop = function(row) return math.abs(row.axial_strain) >= P.elastic_strain end})
   local s = r.series
@@ -299,6 +320,32 @@ if want.elastic then
   nu = (elastic.compression.poisson_ratio + elastic.tension.poisson_ratio) / 2
   E_slab = (elastic.compression.young_modulus_slab_pa + elastic.tension.young_modulus_slab_pa) / 2
   nu_slab = (elastic.compression.poisson_ratio_slab + elastic.tension.poisson_ratio_slab) / 2
+end
+
+-- Isotropy [scenarios.md 2.4]: E and nu in compression along x, y and z.
+local by_axis
+if want.isotropy then
+  by_axis = {young_modulus = {z = elastic.compression.young_modulus_pa}, poisson_ratio = {z = elastic.compression.poisson_ratio}}
+  for _, axis in ipairs{"x", "y"} do
+    timed("isotropy_" .. axis, function()
+      local w = bonded(with(bond_material, {breakable = false}), nil, axis)
+      prepare(w, "elastic_" .. axis)
+      w = nil
+      collectgarbage()
+      local r = elastic_axial("elastic_compression_" .. axis, -1, "elastic_" .. axis)
+      by_axis.young_modulus[axis], by_axis.poisson_ratio[axis] = r.young_modulus_pa, r.poisson_ratio
+    end)
+  end
+  local function spread(t)
+    local lo, hi, m = math.huge, -math.huge, 0
+    for _, a in ipairs{"x", "y", "z"} do lo, hi, m = math.min(lo, t[a]), math.max(hi, t[a]), m + t[a] / 3 end
+    return (hi - lo) / m
+  end
+  by_axis.young_modulus_spread = spread(by_axis.young_modulus)
+  by_axis.poisson_ratio_spread = spread(by_axis.poisson_ratio)
+  log("isotropy: E x/y/z = %.4g / %.4g / %.4g Pa (spread %.1f %%), nu = %.3f / %.3f / %.3f (spread %.1f %%)",
+      by_axis.young_modulus.x, by_axis.young_modulus.y, by_axis.young_modulus.z, 100 * by_axis.young_modulus_spread,
+      by_axis.poisson_ratio.x, by_axis.poisson_ratio.y, by_axis.poisson_ratio.z, 100 * by_axis.poisson_ratio_spread)
 end
 
 local shear
@@ -425,11 +472,15 @@ local summary = {
   n_particles = packing.n_particles, porosity_nominal = packing.porosity_nominal,
   porosity_true = packing.porosity_true, mean_radius_m = packing.mean_radius,
   radius_dispersion = packing.radius_stats.dispersion, coordination_packed = packing.coordination,
-  wall_stress_pa = packing.wall_stress_pa, wall_stress_expanded_pa = packing.wall_stress_expanded_pa,
-  packing_steps = packing.expansion.steps, packing_stress_target_pa = P.packing_stress,
-  stress_free_bonds = P.stress_free_bonds,
-  radius_factor_stress_installation = packing.stress_installation and packing.stress_installation.factor or 1,
-  stress_installation = packing.stress_installation,  -- {factor, stress, iterations, steps, reached}
+  wall_stress_pa = packing.wall_stress_pa,
+  genesis = {particles_generated = packing.n_generated, floaters_removed = packing.genesis.floaters_removed,
+             stress_pa = packing.genesis.stress_pa, stress_target_pa = P.genesis_stress,
+             stress_reached = packing.genesis.stress_reached, radius_factor = packing.genesis.radius_factor,
+             coordination = packing.genesis.coordination, steps = packing.genesis.steps,
+             seconds = packing.genesis.seconds, porosity_nominal = packing.porosity_nominal,
+             porosity_true = packing.porosity_true},
+  bond_stress_max_over_st = residual.max_over_st,
+  bonds_above_third_of_st = residual.above_third_of_st,
   bonds = elastic_info.bonds, bonds_per_particle = 2 * elastic_info.bonds / packing.n_particles,
   residual_bond_stress = residual,
   young_modulus_pa = E, poisson_ratio = nu,
@@ -437,6 +488,10 @@ local summary = {
   shear_modulus_isotropic_pa = E and nu and E / (2 * (1 + nu)),  -- nil without the elastic test
   shear_modulus_isotropic_slab_pa = E_slab and nu_slab and E_slab / (2 * (1 + nu_slab)),
   elastic = elastic, shear = shear,
+  young_modulus_by_axis_pa = by_axis and by_axis.young_modulus,
+  poisson_ratio_by_axis = by_axis and by_axis.poisson_ratio,
+  young_modulus_spread = by_axis and by_axis.young_modulus_spread,
+  poisson_ratio_spread = by_axis and by_axis.poisson_ratio_spread,
   stress_scale = scale, young_modulus_rock_pa = mat.rock.young_modulus,
   bond_tensile_strength_pa = P.tensile_strength,
   rate_m_per_s = P.rate, dt_s = nil, rate_check = rate_check,
@@ -464,6 +519,7 @@ if fracture then
     summary.strength_ratio = fracture.compression.strength_pa / fracture.tension.strength_pa
   end
   summary.broken_in_relaxation = fracture.relaxation.broken_in_relaxation
+  summary.bonds_broken_in_relaxation = fracture.relaxation.broken_in_relaxation
 end
 summary.seconds = asperity.wall_time() - clock0
 asperity.write_json(out .. "/summary.json", summary)

@@ -21,9 +21,10 @@ namespace asperity {
 namespace {
 
 using detail::State;
-constexpr int kCheckpointVersion = 4;  // 2: servo integral and integral time, group damping;
+constexpr int kCheckpointVersion = 5;  // 2: servo integral and integral time, group damping;
                                        // 3: rest overlaps (stress-free bonds);
-                                       // 4: meshes' candidates within half the skin
+                                       // 4: meshes' candidates within half the skin;
+                                       // 5: rotation_lock_bonds
 
 template <class T>
 hid_t native_type() {
@@ -145,6 +146,7 @@ void visit(Io& io, State& s) {
   io.flag("settings/track_energy", ws.track_energy);
   io.scalar("settings/reorder_interval", ws.reorder_interval);
   io.flag("settings/lock_bonded_rotation", ws.lock_bonded_rotation);
+  if (io.version >= 5) io.scalar("settings/rotation_lock_bonds", ws.rotation_lock_bonds);
 
   // Clock, time step, neighbour bookkeeping, ledgers.
   io.scalar("run/step", s.step);

@@ -100,11 +100,13 @@ void refresh_bond_topology(State& s) {
   s.bond_moments_zero = true;
   for (std::size_t k = 0; k < q.n && s.bond_moments_zero; ++k)
     s.bond_moments_zero = q.mbn[k] == 0 && q.mbsx[k] == 0 && q.mbsy[k] == 0 && q.mbsz[k] == 0;
-  // Rotation locks [thesis 3.3]: a particle holding an intact bond does not rotate.
+  // Rotation locks [thesis 3.3]: a particle holding at least rotation_lock_bonds intact bonds does
+  // not rotate ("restricting the particle rotation when they are bonded together"; how far the
+  // restriction goes is the calibration's choice, model.md 2).
   s.user_rotation_locked.resize(p.n, 0);
   s.any_rotating = false;
   for (std::size_t i = 0; i < p.n; ++i) {
-    const bool bonded = s.partner_start[i + 1] > s.partner_start[i];
+    const bool bonded = s.partner_start[i + 1] - s.partner_start[i] >= s.settings.rotation_lock_bonds;
     const bool locked = !s.settings.rotation || s.user_rotation_locked[i] ||
                         (s.settings.lock_bonded_rotation && bonded);
     if (locked && !p.rotation_locked[i]) p.wx[i] = p.wy[i] = p.wz[i] = 0;

@@ -84,6 +84,7 @@ int world_new(lua_State* L) {
     s.track_energy = o.boolean("track_energy", s.track_energy);
     s.reorder_interval = static_cast<int>(o.integer("reorder_interval", s.reorder_interval));
     s.lock_bonded_rotation = o.boolean("lock_bonded_rotation", s.lock_bonded_rotation);
+    s.rotation_lock_bonds = static_cast<int>(o.integer("rotation_lock_bonds", s.rotation_lock_bonds));
     o.finish();
     // Construct before setting the metatable: if the constructor throws, no __gc will ever run
     // on the uninitialised block.
@@ -143,6 +144,7 @@ int world_settings(lua_State* L) {
     boolean("track_energy", s.track_energy);
     integer("reorder_interval", s.reorder_interval);
     boolean("lock_bonded_rotation", s.lock_bonded_rotation);
+    integer("rotation_lock_bonds", s.rotation_lock_bonds);
     return 1;
   });
 }
@@ -1355,7 +1357,8 @@ void open_world(lua_State* L) {
        "(auto), dt = 0 (auto), dt_safety = 0.8, allow_dt_above_estimate = false,\n"
        "dt_interval = 100, threads = 0 (automatic), simd = \"auto\" (scalar, sse4_2, avx2, avx512f;\n"
        "float: the force laws in single precision, scalar, for the run-time study),\n"
-       "track_energy = true, reorder_interval = 10, lock_bonded_rotation = true."},
+       "track_energy = true, reorder_interval = 10, lock_bonded_rotation = true,\n"
+       "rotation_lock_bonds = 1 (the lock holds while a particle has at least this many intact bonds)."},
       {"load", l_load, "asperity.load(path [, {threads=, simd=}]) -> World",
        "A world from a checkpoint written by world:save(path)."},
       {"bond_criterion", l_bond_criterion, "asperity.bond_criterion(sigma, tau, tensile_strength) -> f",

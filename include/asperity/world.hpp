@@ -60,6 +60,8 @@ struct WorldSettings {
   bool track_energy = true;         // friction, damping and boundary work ledgers (model.md 8)
   int reorder_interval = 10;        // neighbour rebuilds between reorders by cell; 0: never
   bool lock_bonded_rotation = true; // a particle holding an intact bond does not rotate (model.md 2)
+  int rotation_lock_bonds = 1;      // ... holding at least this many intact bonds: the restriction
+                                    // ends once a particle has lost all but fewer of its bonds
 };
 
 // How a rigid group's degree of freedom moves (model.md 1, 7).

@@ -16,6 +16,12 @@ M.density = 2500            -- kg/m^3 (the source gives none)
 -- Packing [thesis 3.3, scenarios.md 1]: radii Gaussian 0.5 mm +- 0.1 mm cut at 3 SD, n = 0.51.
 M.packing = {mean_radius = 0.5e-3, radius_sd = 0.1e-3, cut = 3, porosity = 0.51}
 
+-- Genesis [scenarios.md 1; lib/genesis.lua]: the particle count from the thesis's porosity
+-- definition [3-35] at `porosity` (denser than the thesis's 0.51: a frictionless assembly jams
+-- near 0.45 in a 1 cm box), compacted without friction, the isotropic `stress` installed by a
+-- common radius factor, particles with fewer than `floater_contacts` contacts taken out.
+M.genesis = {porosity = 0.45, stress = 1e-3, floater_contacts = 3}
+
 -- Target rock, thesis Table 3-1 (mortar replicas of granite).
 M.rock = {young_modulus = 30853e6, poisson_ratio = 0.187, compressive_strength = 74.6e6,
           tensile_strength = 6.6e6}
@@ -27,35 +33,18 @@ M.rock = {young_modulus = 30853e6, poisson_ratio = 0.187, compressive_strength =
 -- compressive strength of 131.8 MPa scaled (Table 3-1: 74.6), sc/st = 20 (source: about 10);
 -- see issue notes: the packing is looser than the source's (coordination 3).
 M.rev = {
-  young_modulus = 36.08,          -- Pa, E_REV (model units); the source's REV had 49 Pa
-  bond_tensile_strength = 0.020623, -- Pa, st of the elliptic criterion
-  packing_stress = 0.005,         -- Pa, wall stress asked of the stress installation before bonding
-  stress_free_bonds = false,      -- model.md 5: bonds keep the existing contact forces
+  young_modulus = 36.08,          -- Pa, E_REV (model units)
+  bond_tensile_strength = 0.0345, -- Pa, st of the elliptic criterion
+  bond_shear_ratio = 0.3,         -- kbs / kbn of the parallel bonds
+  bond_radius_factor = 1,         -- lambda [3-26]
+  rotation_lock_bonds = 3,        -- bonded particles do not rotate while they hold this many bonds
 }
-
--- The same REV bonded as packed (no stress installation) with stress-free bonds
--- (world:install_bonds{stress_free = true}: the packing's 0.20 Pa wall stress is not locked into
--- the bonds), from
---   build/asperity run scripts/calibrate_rev.lua packing_stress=0 stress_free_bonds=true compression=true start=0.0222
--- (2026-11-25, 1 trial): E_REV 48.83 Pa (the source's REV: 49 Pa), nu 0.226, REV tensile strength
--- 0.01045 Pa = 6.60 MPa scaled (source: 0.0111 Pa), compressive 0.1988 Pa = 125.6 MPa, sc/st 19.
--- The joint scenario uses it with stress_free_bonds=true (its halves are bonded as packed too).
-M.rev_stress_free = {
-  young_modulus = 48.832,
-  bond_tensile_strength = 0.0222,
-  packing_stress = 0,
-  stress_free_bonds = true,
-}
-
--- The REV material that matches a preparation: stress-free bonds or model.md 5's.
-function M.rev_for(stress_free_bonds)
-  return stress_free_bonds and M.rev_stress_free or M.rev
-end
 
 -- Bond material for world:install_bonds: beams as stiff as the contact springs (kbn A = kn,
 -- kbs A = ks), lambda = 1, the calibrated strength; `over` replaces fields.
 function M.bond(over)
-  local b = {beam_kn = M.contact.kn, beam_ks = M.contact.ks, radius_factor = 1,
+  local b = {beam_kn = M.contact.kn, beam_ks = M.contact.kn * M.rev.bond_shear_ratio,
+             radius_factor = M.rev.bond_radius_factor,
              tensile_strength = M.rev.bond_tensile_strength}
   for k, v in pairs(over or {}) do b[k] = v end
   if b.breakable == false then b.tensile_strength = nil end
