@@ -25,7 +25,7 @@
 -- count, broken bonds, energies, and maps of contact points and broken bonds over the elevation.
 local mat = require("materials")
 local radii_lib = require("radii")
-local pack = require("pack")
+local genesis = require("genesis")
 local heightmap = require("heightmap")
 
 local P = require("params").defaults{
@@ -55,11 +55,10 @@ local P = require("params").defaults{
   approach_gap = 0.2e-3,    -- m, smallest gap left between the halves after lowering the upper one
   gap = 1e-3,              -- m, between the halves while they relax
   platen = 1.5e-3,         -- m, layer of each outer face that forms a platen
-  porosity = 0.51,
-  wall_friction = mat.contact.friction, -- of the box walls and the mould while packing (the REV's box: 0; scripts/README.md)
-  packing_stress = 0,      -- Pa: > 0 installs this wall stress before bonding, as the REV does (0: bond as packed)
-  stress_free_bonds = false, -- true: each contact bond unloaded at its installed overlap, so the packing's
-                           -- stress is not locked into the bonds (not model.md 5's rule; scripts/README.md)
+  porosity = mat.genesis.porosity,  -- thesis definition [3-35]: the particle count of the genesis
+  genesis_stress = mat.genesis.stress, -- Pa, isotropic stress installed before bonding (scenarios.md 1)
+  bond_gap = 0,            -- m, largest gap bonded (0: the engine's default, 1e-3 x mean radius)
+  wall_friction = 0,       -- of the box walls and the mould during the genesis (scenarios.md 1: frictionless)
   seed = 1,
   pack_steps = 300000,     -- most steps spent cycling the packing towards the ratio 1e-4
   record = 0.01,           -- mm of shear between records
@@ -128,20 +127,20 @@ local zmin, zmax = math.huge, -math.huge
 for _, z in ipairs(heights) do zmin, zmax = math.min(zmin, z), math.max(zmax, z) end
 local T = P.thickness
 
--- 2. The specimen: packed, bonded, relaxed halves (cached) ---------------------------------
--- v6: install_bonds marked a half's particles before a reorder of the store, which could bond
--- the other particles (the 4 cm S1 joint had 5 bonds across the mould and 17 % of its particles
--- left out); specimens cached before the fix are not reused.
-local key = ("%s_%s_n%d_h%.6g_T%.6g_p%.4g_s%d_g%.6g_k%d"):format(
-  P.surface_file ~= "" and P.surface_file:gsub("[^%w]", "_") or P.surface, "v6", n, h, T,
-  P.porosity, P.seed, P.gap, P.pack_steps) .. (P.wall_friction ~= mat.contact.friction and ("_f%.3g"):format(P.wall_friction) or "") ..
-  (P.packing_stress > 0 and ("_ps%.3g"):format(P.packing_stress) or "") .. (P.stress_free_bonds and "_sf" or "")
+-- 2. The specimen: the genesis of both halves, bonded, relaxed (cached) ----------------------
+-- Both halves are made by the REV's genesis (lib/genesis.lua, scenarios.md 1) in one box split by
+-- the mould, so the joint is made of the material the REV calibrates.
+local key = ("%s_%s_n%d_h%.6g_T%.6g_p%.4g_s%d_g%.6g_k%d_gs%.4g_fc%d_l%d_b%.4g_%.4g_gap%.4g"):format(
+  P.surface_file ~= "" and P.surface_file:gsub("[^%w]", "_") or P.surface, "v7", n, h, T,
+  P.porosity, P.seed, P.gap, P.pack_steps, P.genesis_stress, mat.genesis.floater_contacts,
+  mat.rev.rotation_lock_bonds, mat.rev.bond_shear_ratio, mat.rev.bond_radius_factor, P.bond_gap)
+  .. (P.wall_friction ~= 0 and ("_f%.3g"):format(P.wall_friction) or "")
 local cache_file = P.cache .. "/joint_" .. key .. ".h5"
 local LOWER, UPPER, LOST, POROSITY = 1, 2, 3, 1   -- tags; POROSITY is a flag bit
 
 local function build_specimen()
   local w = asperity.world{material = mat.contact, damping = mat.damping, density = mat.density,
-                           threads = P.threads}
+                           threads = P.threads, rotation_lock_bonds = mat.rev.rotation_lock_bonds}
   -- Boxes: sides, floor of the lower half, roof of the upper one; the mould between them.
   local wm = {kn = mat.contact.kn, ks = mat.contact.ks, friction = P.wall_friction}
   local planes = {
@@ -152,29 +151,41 @@ local function build_specimen()
     w:add_plane{point = {0, 0, -T}, normal = {0, 0, 1}, material = wm},
     w:add_plane{point = {0, 0, T}, normal = {0, 0, -1}, material = wm},
   }
+  local box = {x_min = planes[1], x_max = planes[2], y_min = planes[3], y_max = planes[4],
+               bottom = planes[5], top = planes[6]}
   local mesh = heightmap.mesh{heights = heights, nx = nx, ny = ny, dx = h, dy = h, origin = {0, 0, 0}}
   local mould = w:add_mesh{vertices = mesh.vertices, triangles = mesh.triangles, material = wm}
   -- Particle count from the thesis porosity definition [3-35, 3-36] over both halves.
   local volume = Lx * Ly * 2 * T
   local count = radii_lib.count_for_porosity{volume = volume, porosity = P.porosity,
                                              mean_radius = mat.packing.mean_radius}
-  -- normalise_mean: the sample's mean radius is exactly <R>, so the thesis's nominal porosity is
-  -- the one asked for (as in the REV); without it seed 1 packed the default joint at 0.5035, dense
-  -- enough to jam at 1 Pa of wall stress and lock that stress into the bonds.
   local r = radii_lib.truncated_gaussian{count = count, mean = mat.packing.mean_radius,
                                          sd = mat.packing.radius_sd, seed = P.seed, normalise_mean = true}
-  log("packing %d particles in two halves of %.1f x %.1f mm (surface %s, %d x %d grid)", count,
+  log("genesis of %d particles in two halves of %.1f x %.1f mm (surface %s, %d x %d grid)", count,
       Lx * 1e3, Ly * 1e3, P.surface_file ~= "" and P.surface_file or P.surface, nx, ny)
   local lo, hi = {0, 0, -T}, {Lx, Ly, T}   -- the box of both halves
-  local packed = pack.expand(w, {min = lo, max = hi, radii = r, seed = P.seed,
-                                 volume = volume, progress = P.progress, max_steps = P.pack_steps,
-                                 inside = function(x, y, z, rad)
-                                   local s = surface_z(x, y)
-                                   return z + rad < s - rad or z - rad > s + rad
-                                 end})
-  log("packed in %d steps (%.0f s): porosity %.3f nominal, %.3f true; unbalanced-force ratio %.2g%s",
-      packed.steps, packed.seconds, packed.porosity_nominal, packed.porosity_true, packed.ratio,
-      packed.reached and "" or (" (not below 1e-4 within pack_steps = %d)"):format(P.pack_steps))
+  local g = genesis.pack(w, {min = lo, max = hi, radii = r, seed = P.seed, box = box, volume = volume,
+                             stress = P.genesis_stress, friction = mat.contact.friction,
+                             min_contacts = mat.genesis.floater_contacts, floater_tag = LOST,
+                             progress = P.progress, max_steps = P.pack_steps,
+                             log = function(fmt, ...) log(fmt, ...) end,
+                             split = function(x, y, z) return z < surface_z(x, y) and 1 or 2 end,
+                             sets_count = 2,   -- each half gets its own radius factor
+                             wall_contacts = function(x, y, z, rad)
+                               local n = 0
+                               if x < rad then n = n + 1 end
+                               if Lx - x < rad then n = n + 1 end
+                               if y < rad then n = n + 1 end
+                               if Ly - y < rad then n = n + 1 end
+                               if z + T < rad or T - z < rad then n = n + 1 end
+                               -- the mould, by the vertical distance (a slope only makes it nearer)
+                               if math.abs(z - surface_z(x, y)) < rad then n = n + 1 end
+                               return n
+                             end,
+                             inside = function(x, y, z, rad)
+                               local s = surface_z(x, y)
+                               return z + rad < s - rad or z - rad > s + rad
+                             end})
   if P.stop_after == "packing" then
     if P.save ~= "" then
       w:save(P.save)
@@ -182,30 +193,16 @@ local function build_specimen()
     else
       log("stopped after packing (stop_after); nothing saved (give save=FILE to keep the world)")
     end
-    return nil, {stopped_after = "packing", particles = w:particle_count(), steps = packed.steps,
-                 ratio = packed.ratio, porosity_nominal = packed.porosity_nominal,
-                 porosity_true = packed.porosity_true, seconds = packed.seconds,
-                 saved = P.save ~= "" and P.save or nil}
-  end
-  -- Mean compressive stress on the box walls: what the bonds will lock in once the walls go.
-  local box = {x_min = planes[1], x_max = planes[2], y_min = planes[3], y_max = planes[4],
-               bottom = planes[5], top = planes[6]}
-  local wall_stress = pack.mean_box_wall_stress(w, box, lo, hi)
-  log("mean wall stress after packing %.3g Pa", wall_stress)
-  if P.packing_stress > 0 then
-    local s = pack.install_stress(w, {first = packed.first, last = packed.last, walls = box, min = lo,
-                                      max = hi, target = P.packing_stress, ratio = 1e-4})
-    log("stress installation: radii x %.5f, wall stress %.4g Pa (target %.4g) after %d iterations, %d steps",
-        s.factor, s.stress, P.packing_stress, s.iterations, s.steps)
-    wall_stress = s.stress
+    return nil, {stopped_after = "packing", particles = w:particle_count(), steps = g.steps,
+                 porosity_nominal = g.porosity_nominal, porosity_true = g.porosity_true,
+                 seconds = g.seconds, saved = P.save ~= "" and P.save or nil}
   end
   -- Halves by side of the mould; tags 1 (lower) and 2 (upper). A particle squeezed out of the
-  -- box during the expansion (a small one between two growing ones can be shot through a wall)
-  -- belongs to neither half.
+  -- box during the compaction belongs to neither half.
   local pos = w:positions()
   local lower, upper, lost = {}, {}, {}
   local slack = 1e-9
-  for id = 1, w:particle_count() do
+  for _, id in ipairs(g.kept) do
     local p = pos[id]
     if p[1] < -slack or p[1] > Lx + slack or p[2] < -slack or p[2] > Ly + slack
        or p[3] < -T - slack or p[3] > T + slack then
@@ -214,54 +211,67 @@ local function build_specimen()
   end
   w:set_tag(lower, LOWER)
   w:set_tag(upper, UPPER)
-  -- Bond each half on its own (never across the mould), unbreakable while prepared.
-  local bonds = w:install_bonds{breakable = false, ids = lower, stress_free = P.stress_free_bonds} +
-                w:install_bonds{breakable = false, ids = upper, stress_free = P.stress_free_bonds}
-  -- Floaters: particles of a half without a bond carry nothing and would drift off once the
-  -- walls go. Lost particles and floaters are made inert (neither integrated nor searched) and
-  -- tagged LOST, so no half, platen or measure counts them.
-  local bonded, across = {}, 0
-  for _, b in ipairs(w:bonds()) do
-    bonded[b.a], bonded[b.b] = true, true
-    if w:tag(b.a) ~= w:tag(b.b) then across = across + 1 end
-  end
-  if across > 0 then  -- the halves would be glued together: no joint to shear
-    error(("%d bonds join the lower and the upper half: the specimen is not two halves"):format(across), 0)
-  end
-  local function keep(list)
-    local kept = {}
-    for _, id in ipairs(list) do
-      if bonded[id] then kept[#kept + 1] = id else lost[#lost + 1] = id end
+  -- Bond each half on its own (never across the mould), unbreakable while prepared; remove the
+  -- walls, part the halves by `gap`, relax [scenarios.md 3.3].
+  local bond_material = mat.bond{breakable = false}
+  if P.bond_gap > 0 then bond_material.tolerance = P.bond_gap end
+  local walls_list = {mould}
+  for _, id in ipairs(planes) do walls_list[#walls_list + 1] = id end
+  local b = genesis.bond(w, {sets = {lower, upper}, material = bond_material, walls = walls_list,
+                             tensile_strength = mat.rev.bond_tensile_strength, progress = P.progress,
+                             log = function(fmt, ...) log(fmt, ...) end,
+                             before_relax = function(w)
+    -- Particles of a half without a bond carry nothing and would drift off: made inert (neither
+    -- integrated nor searched) and tagged LOST, like those squeezed out, so no half, platen or
+    -- measure counts them.
+    local bonded, across = {}, 0
+    for _, bd in ipairs(w:bonds()) do
+      bonded[bd.a], bonded[bd.b] = true, true
+      if w:tag(bd.a) ~= w:tag(bd.b) then across = across + 1 end
     end
-    return kept
-  end
-  lower, upper = keep(lower), keep(upper)
-  if #lost > 0 then
-    w:set_tag(lost, LOST)
-    w:add_group(lost, {translation = "fixed"})   -- inert particles must belong to a rigid body
-    w:set_inert(lost)
-    log("%d particles left out (outside the box after packing, or without a bond)", #lost)
-  end
-  -- Remove the walls, part the halves by `gap`, relax [scenarios.md 3.3].
-  for _, p in ipairs(planes) do w:remove_wall(p) end
-  w:remove_wall(mould)
-  for _, id in ipairs(upper) do
-    local p = w:position(id)
-    w:set_position(id, {p[1], p[2], p[3] + P.gap})
-  end
-  local steps, why = w:run{stop_when = "equilibrium", ratio = 1e-4, steps = 200000,
-                           progress = P.progress}
-  log("bonded (%d bonds), walls removed, relaxed in %d steps (%s)", bonds, steps, why)
+    if across > 0 then  -- the halves would be glued together: no joint to shear
+      error(("%d bonds join the lower and the upper half: the specimen is not two halves"):format(across), 0)
+    end
+    local function keep(list)
+      local kept = {}
+      for _, id in ipairs(list) do
+        if bonded[id] then kept[#kept + 1] = id else lost[#lost + 1] = id end
+      end
+      return kept
+    end
+    lower, upper = keep(lower), keep(upper)
+    if #lost > 0 then
+      w:set_tag(lost, LOST)
+      w:add_group(lost, {translation = "fixed"})   -- inert particles must belong to a rigid body
+      w:set_inert(lost)
+    end
+    for _, id in ipairs(upper) do
+      local p = w:position(id)
+      w:set_position(id, {p[1], p[2], p[3] + P.gap})
+    end
+  end})
+  log("%d particles left out (floaters %d; outside the box or without a bond %d)", g.floaters_removed + #lost,
+      g.floaters_removed, #lost)
   w:save(cache_file)
-  asperity.write_json(cache_file .. ".json", {particles = w:particle_count(), lower = #lower,
-    upper = #upper, left_out = #lost, bonds = bonds, porosity_nominal = packed.porosity_nominal,
-    porosity_true = packed.porosity_true, packing_steps = packed.steps, relax_steps = steps,
-    packing_seconds = packed.seconds, wall_stress_pa = wall_stress})
-  return w
+  local record = {particles = w:particle_count(), lower = #lower, upper = #upper,
+    left_out = g.floaters_removed + #lost, floaters_removed = g.floaters_removed, bonds = b.bonds,
+    porosity_nominal = g.porosity_nominal, porosity_true = g.porosity_true, mean_radius = g.mean_radius,
+    coordination = g.coordination, genesis_stress_pa = g.stress_pa, genesis_stress_target_pa = P.genesis_stress,
+    genesis_stress_reached = g.stress_reached, radius_factor = g.radius_factor, genesis_steps = g.steps,
+    genesis_seconds = g.seconds, relax_steps = b.relax_steps, relax_reached = b.relax_reached,
+    bonds_broken_in_relaxation = b.broken_in_relaxation, bond_stress = b.bond_stress,
+    bond_stress_max_over_st = b.bond_stress_max_over_st, wall_stress_pa = g.wall_stress_pa}
+  asperity.write_json(cache_file .. ".json", record)
+  local f = assert(io.open(cache_file .. ".lua.tmp", "w"))
+  f:write("return " .. genesis.serialise(record) .. "\n")
+  f:close()
+  os.rename(cache_file .. ".lua.tmp", cache_file .. ".lua")
+  return w, record
 end
 
-local world
-local f = io.open(cache_file, "r")
+local world, specimen_record
+-- The record is written last: a specimen without one was cut short and is built again.
+local f = io.open(cache_file .. ".lua", "r")
 if f then
   f:close()
   if P.stop_after == "packing" then
@@ -269,10 +279,10 @@ if f then
   end
   log("reusing the cached specimen %s", cache_file)
   world = asperity.load(cache_file, {threads = P.threads, simd = P.simd})
+  specimen_record = dofile(cache_file .. ".lua")
 else
-  local packing
-  world, packing = build_specimen()
-  if not world then return packing end   -- stop_after = "packing"
+  world, specimen_record = build_specimen()
+  if not world then return specimen_record end   -- stop_after = "packing"
   if P.simd ~= "auto" then world = asperity.load(cache_file, {threads = P.threads, simd = P.simd}) end
 end
 -- Numerical settings of the test (perf/runtime_vs_error.lua chose them; 0 keeps the engine's).
@@ -339,7 +349,7 @@ end
 -- 4. The model, platens ----------------------------------------------------------------------
 local area = Lx * Ly
 -- The REV calibrated with the same bond installation as these halves (scripts/lib/materials.lua).
-local rev = mat.rev_for(P.stress_free_bonds)
+local rev = mat.rev
 local stress_scale = mat.rock.young_modulus / rev.young_modulus        -- [3-37]
 local target_stress = P.stress * 1e6 / stress_scale                   -- model units, Pa
 local function mpa(sigma) return sigma * stress_scale / 1e6 end
@@ -396,9 +406,8 @@ else
     if over > 0.01 * #all then
       error(("model=fracture: %d of %d bonds (%.0f %%) of the prepared specimen carry stresses that need " ..
              "a strength above the calibrated st = %.4g Pa (largest %.4g Pa): the packing locked more " ..
-             "stress into the halves than the REV's. Run model=elastic or rigid, or bond the halves " ..
-             "stress_free_bonds=true (the packing's stress is then not locked into the bonds; a " ..
-             "departure from model.md 5, see scripts/README.md)."):format(over, #all, 100 * over / #all, st, worst), 0)
+             "stress into the halves than the REV's genesis (scenarios.md 1). Run model=elastic or " ..
+             "rigid, or lower genesis_stress."):format(over, #all, 100 * over / #all, st, worst), 0)
     end
     world:set_bond_strength{tensile_strength = st}
   end
@@ -719,6 +728,7 @@ local summary = {
   dt = world:dt(),
   wall_seconds = asperity.wall_time() - t_start,
   specimen_cache = cache_file,
+  genesis = specimen_record,
 }
 asperity.write_json(P.out .. "/summary.json", summary)
 

@@ -13,11 +13,13 @@
 --      tenth of the radii, radii grown in stages (pack.expand). A frictionless assembly jams
 --      denser than a frictional one and at a reproducible density, so the state below does not
 --      depend on where a frictional packing happened to lock.
---   2. a low isotropic stress installed by scaling all radii by one factor (bracketed, then
---      bisected; pack.install_stress) until the mean stress on the box walls is `stress`.
---   3. floaters (fewer than `min_contacts` ball-ball contacts: rattlers of the jammed assembly,
---      which carry nothing and would get no bond that holds them) are taken out of the specimen:
---      made inert, fixed, and tagged `floater_tag` if given.
+--   2. a low isotropic stress installed by scaling the radii by one factor (M.install_stress)
+--      until the mean stress of the assembly (from its contacts, M.contact_stresses) is `stress`;
+--      with `split(x, y, z)` -> 1..sets_count, each set (the halves of a joint) has its own factor.
+--   3. floaters (fewer than `min_contacts` contacts with particles and walls: rattlers of the
+--      jammed assembly, which carry nothing and would get no bond that holds them) are taken out
+--      of the specimen: made inert, fixed, and tagged `floater_tag` if given. Wall contacts are
+--      counted by `wall_contacts(x, y, z, r)` (default: the faces of the box min..max).
 --   4. the particles' friction restored (world:set_friction); the walls stay frictionless.
 -- bond:
 --   5. bonds installed in each id set on its own (model.md 5: contacts keep their forces, beams
@@ -47,11 +49,107 @@ function M.contact_counts(world)
   return counts
 end
 
+-- Mean stress of an assembly from its ball-ball contacts (Love-Weber): p = sum Fn d / (3 V), d the
+-- distance of the two centres, over the contacts whose both particles are in `member` (a table
+-- id -> set index) and of set `k`, or all. Unlike the wall stress it does not count particles wedged
+-- between a wall and the mould, and it is the stress the bonds inherit.
+function M.contact_stresses(world, member, volumes)
+  local r = world:radii()
+  local sums = {}
+  for k = 1, #volumes do sums[k] = 0 end
+  for _, c in ipairs(world:contacts()) do
+    local k = member[c.a]
+    if k and member[c.b] == k then
+      sums[k] = sums[k] + c.normal_force * (r:get(c.a) + r:get(c.b) - c.overlap)
+    end
+  end
+  for k = 1, #volumes do sums[k] = sums[k] / (3 * volumes[k]) end
+  return sums
+end
+
+-- The isotropic stress installation [scenarios.md 1; Potyondy & Cundall 2004]: the radii of each
+-- set scaled by one factor of its own until its mean stress is `target` within `tolerance`,
+-- cycling to equilibrium after each change. Sets that do not touch (the halves of a joint, apart
+-- behind the mould) are independent and are searched together, one cycling per iteration. Per set:
+-- the factor is bracketed (steps from 1e-3, doubling), then found by regula falsi where both ends
+-- carry stress (above jamming the stress grows about linearly with the factor; Illinois: an end
+-- kept twice has its weight halved) and by bisection where the lower end carries none.
+function M.install_stress(world, o)
+  local sets, volumes, target = o.sets, o.volumes, o.target
+  local tol, ratio = o.tolerance or 0.1, o.ratio or 1e-4
+  local member = {}
+  for k, ids in ipairs(sets) do for _, id in ipairs(ids) do member[id] = k end end
+  local st = {}
+  for k = 1, #sets do st[k] = {f = 1, step = 1e-3, done = false} end
+  local steps, iterations = 0, 0
+  local function cycle_and_measure()
+    pack.refresh_dt(world)
+    steps = steps + 1 + world:run{steps = o.max_steps or 200000, every = 100, stop_when = function(w)
+      return w:unbalanced_force_ratio() <= ratio or (w:contact_count() == 0 and w:stats().wall_contacts == 0)
+    end}
+    iterations = iterations + 1
+    return M.contact_stresses(world, member, volumes)
+  end
+  local function good(p) return math.abs(p - target) <= tol * target end
+  local function record(s, f, p)
+    if p > target then
+      if s.kept == "lo" and s.p_lo and s.p_lo > 0 then s.p_lo = 0.5 * (s.p_lo + target) end
+      s.f_hi, s.p_hi, s.kept = f, p, "lo"
+    else
+      if s.kept == "hi" and s.p_hi then s.p_hi = 0.5 * (s.p_hi + target) end
+      s.f_lo, s.p_lo, s.kept = f, p, "hi"
+    end
+    s.p = p
+    s.done = good(p)
+  end
+  local p = cycle_and_measure()
+  for k, s in ipairs(st) do
+    record(s, 1, p[k])
+    s.kept = nil
+  end
+  local max_it = o.iterations or 40
+  while iterations < max_it do
+    local busy = false
+    for k, s in ipairs(st) do
+      if not s.done then
+        local f
+        if not (s.f_lo and s.f_hi) then                       -- bracket
+          f = s.f_hi and s.f_hi * (1 - s.step) or s.f_lo * (1 + s.step)
+          s.step = s.step * 2
+        elseif s.f_hi - s.f_lo <= 1e-7 then
+          f = nil                                              -- as close as it gets
+        elseif s.p_lo > 0 then                                 -- regula falsi
+          f = s.f_lo + (target - s.p_lo) * (s.f_hi - s.f_lo) / (s.p_hi - s.p_lo)
+          if not (f > s.f_lo and f < s.f_hi) then f = 0.5 * (s.f_lo + s.f_hi) end
+        else
+          f = 0.5 * (s.f_lo + s.f_hi)
+        end
+        if f then
+          local change = f / s.f
+          for _, id in ipairs(sets[k]) do world:set_radius(id, world:radius(id) * change) end
+          s.f, busy = f, true
+        else
+          s.done = true
+        end
+      end
+    end
+    if not busy then break end
+    p = cycle_and_measure()
+    for k, s in ipairs(st) do if not s.done then record(s, s.f, p[k]) elseif s.p then s.p = p[k] end end
+  end
+  local out = {iterations = iterations, steps = steps, factors = {}, stresses = {}, reached = true}
+  for k, s in ipairs(st) do
+    out.factors[k], out.stresses[k] = s.f, p[k]
+    out.reached = out.reached and good(p[k])
+  end
+  return out
+end
+
 function M.pack(world, o)
   check(o, {min = true, max = true, inside = true, radii = true, seed = true, box = true, walls = true,
             volume = true, stress = true, tolerance = true, friction = true, ratio = true,
             min_contacts = true, floater_tag = true, progress = true, stages = true, stage_steps = true,
-            max_steps = true, log = true}, "genesis.pack")
+            max_steps = true, log = true, wall_contacts = true, split = true, sets_count = true}, "genesis.pack")
   assert(o.min and o.max and o.radii and o.box, "genesis.pack: min, max, radii and box are required")
   assert(o.stress and o.stress > 0, "genesis.pack: stress (Pa, > 0) is required")
   local log = o.log or function() end
@@ -64,21 +162,52 @@ function M.pack(world, o)
                                        progress = o.progress, stages = o.stages, stage_steps = o.stage_steps,
                                        max_steps = o.max_steps})
   local first, last = expanded.first, expanded.last
-  local stress0 = pack.mean_box_wall_stress(world, o.box, o.min, o.max)
-  log("compacted %d particles without friction in %d steps: wall stress %.3g Pa, coordination %.2f",
-      last - first + 1, expanded.steps, stress0, expanded.coordination)
-  -- 2. The isotropic stress, by one radius factor.
-  local s = pack.install_stress(world, {first = first, last = last, walls = o.box, min = o.min, max = o.max,
-                                        target = o.stress, tolerance = o.tolerance or 0.1, ratio = ratio,
-                                        max_steps = o.max_steps, iterations = 40})
-  log("stress installed: radii x %.5f, wall stress %.4g Pa (target %.4g) after %d iterations, %d steps",
-      s.factor, s.stress, o.stress, s.iterations, s.steps)
-  -- 3. Floaters out.
+  local volume = o.volume or (o.max[1] - o.min[1]) * (o.max[2] - o.min[2]) * (o.max[3] - o.min[3])
+  -- The sets searched on their own: `split(x, y, z)` -> set index (the halves of a joint), or one.
+  local pos0 = world:positions()
+  local sets, nsets = {}, o.split and o.sets_count or 1
+  for k = 1, nsets do sets[k] = {} end
+  for id = first, last do
+    local k = o.split and o.split(pos0:get(id, 1), pos0:get(id, 2), pos0:get(id, 3)) or 1
+    table.insert(sets[k], id)
+  end
+  local volumes = {}
+  for k = 1, nsets do volumes[k] = volume / nsets end
+  local member = {}
+  for k, ids in ipairs(sets) do for _, id in ipairs(ids) do member[id] = k end end
+  local p0 = M.contact_stresses(world, member, volumes)
+  log("compacted %d particles without friction in %d steps: mean stress %s Pa, coordination %.2f",
+      last - first + 1, expanded.steps, table.concat((function() local t = {} for k, v in ipairs(p0) do t[k] = ("%.4g"):format(v) end return t end)(), " / "), expanded.coordination)
+  -- 2. The isotropic stress, by one radius factor per set.
+  local s = M.install_stress(world, {sets = sets, volumes = volumes, target = o.stress, tolerance = o.tolerance,
+                                     ratio = ratio, max_steps = o.max_steps})
+  local fs, ps = {}, {}
+  for k = 1, nsets do fs[k], ps[k] = ("%.5f"):format(s.factors[k]), ("%.4g"):format(s.stresses[k]) end
+  log("stress installed: radii x %s, mean stress %s Pa (target %.4g) after %d iterations, %d steps%s",
+      table.concat(fs, " / "), table.concat(ps, " / "), o.stress, s.iterations, s.steps,
+      s.reached and "" or " (NOT reached)")
+  -- 3. Floaters out. A particle's contacts with the region's walls count: one held by two
+  -- neighbours against a wall is part of the jammed structure (its bonds will hold it once the
+  -- wall goes, rotation locked).
   local counts = M.contact_counts(world)
   local min_contacts = o.min_contacts or 3
+  local lo, hi = o.min, o.max
+  local function box_contacts(x, y, z, r)
+    local n = 0
+    local c = {x, y, z}
+    for k = 1, 3 do
+      if c[k] - lo[k] < r then n = n + 1 end
+      if hi[k] - c[k] < r then n = n + 1 end
+    end
+    return n
+  end
+  local wall_contacts = o.wall_contacts or box_contacts
+  local pos, rad = world:positions(), world:radii()
   local floaters, kept = {}, {}
   for id = first, last do
-    if (counts[id] or 0) < min_contacts then floaters[#floaters + 1] = id else kept[#kept + 1] = id end
+    local x, y, z = pos:get(id, 1), pos:get(id, 2), pos:get(id, 3)
+    local n = (counts[id] or 0) + wall_contacts(x, y, z, rad:get(id))
+    if n < min_contacts then floaters[#floaters + 1] = id else kept[#kept + 1] = id end
   end
   if #floaters > 0 then
     if o.floater_tag then world:set_tag(floaters, o.floater_tag) end
@@ -90,7 +219,6 @@ function M.pack(world, o)
   local rr = {}
   local all = world:radii()
   for i, id in ipairs(kept) do rr[i] = all:get(id) end
-  local volume = o.volume or (o.max[1] - o.min[1]) * (o.max[2] - o.min[2]) * (o.max[3] - o.min[3])
   local nominal, true_n, mean = radii_lib.porosity(rr, volume)
   local contacts = 0
   for _, id in ipairs(kept) do contacts = contacts + (counts[id] or 0) end
@@ -98,9 +226,10 @@ function M.pack(world, o)
     particles = last - first + 1, kept = kept, floaters = floaters, floaters_removed = #floaters,
     first = first, last = last,
     compaction_steps = expanded.steps, stress_steps = s.steps, steps = expanded.steps + s.steps,
-    radius_factor = s.factor, stress_pa = s.stress, stress_target_pa = o.stress, stress_reached = s.reached,
+    radius_factor = s.factors[1], radius_factors = s.factors, stress_pa = s.stresses[1], stresses_pa = s.stresses,
+    stress_target_pa = o.stress, stress_reached = s.reached,
     wall_stress_pa = pack.box_wall_stresses(world, o.box, o.min, o.max),
-    coordination = contacts / math.max(1, #kept),
+    coordination = contacts / math.max(1, #kept),   -- ball-ball contacts per kept particle
     porosity_nominal = nominal, porosity_true = true_n, mean_radius = mean,
     seconds = asperity.wall_time() - t0,
   }

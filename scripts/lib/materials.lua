@@ -33,8 +33,8 @@ M.rock = {young_modulus = 30853e6, poisson_ratio = 0.187, compressive_strength =
 -- compressive strength of 131.8 MPa scaled (Table 3-1: 74.6), sc/st = 20 (source: about 10);
 -- see issue notes: the packing is looser than the source's (coordination 3).
 M.rev = {
-  young_modulus = 36.08,          -- Pa, E_REV (model units)
-  bond_tensile_strength = 0.0345, -- Pa, st of the elliptic criterion
+  young_modulus = 103.8,          -- Pa, E_REV (model units)
+  bond_tensile_strength = 0.035192, -- Pa, st of the elliptic criterion
   bond_shear_ratio = 0.3,         -- kbs / kbn of the parallel bonds
   bond_radius_factor = 1,         -- lambda [3-26]
   rotation_lock_bonds = 3,        -- bonded particles do not rotate while they hold this many bonds

@@ -230,11 +230,13 @@ end
 -- Returns {factor, stress, iterations, steps, reached}; the porosity changes by factor^3.
 function M.install_stress(world, o)
   local known = {first = true, last = true, walls = true, min = true, max = true, target = true,
-                 tolerance = true, ratio = true, max_steps = true, iterations = true, step = true}
+                 tolerance = true, ratio = true, max_steps = true, iterations = true, step = true,
+                 measure = true}
   for k in pairs(o) do
     if not known[k] then error("pack.install_stress: unknown option '" .. tostring(k) .. "'", 2) end
   end
   local lo, hi, box = o.min, o.max, o.walls
+  local measure = o.measure or function() return M.mean_box_wall_stress(world, box, lo, hi) end
   local target, tol = o.target, o.tolerance or 0.2
   local steps, iterations = 0, 0
   local f_now = 1
@@ -250,24 +252,43 @@ function M.install_stress(world, o)
     end}
     steps = steps + n
     iterations = iterations + 1
-    return M.mean_box_wall_stress(world, box, lo, hi)
+    return measure()
   end
   local function good(p) return math.abs(p - target) <= tol * target end
   local p = stress_at(1)
-  local f_lo, f_hi   -- stress below / above the target
+  local f_lo, f_hi, p_lo, p_hi   -- stress below / above the target
   local step = o.step or 1e-3
-  if p > target then f_hi = 1 else f_lo = 1 end
+  if p > target then f_hi, p_hi = 1, p else f_lo, p_lo = 1, p end
   local max_it = o.iterations or 30
   while not good(p) and not (f_lo and f_hi) and iterations < max_it do   -- bracket
     local f = f_lo and not f_hi and f_lo * (1 + step) or f_hi * (1 - step)
     step = step * 2
     p = stress_at(f)
-    if p > target then f_hi = f else f_lo = f end
+    if p > target then f_hi, p_hi = f, p else f_lo, p_lo = f, p end
   end
-  while not good(p) and iterations < max_it and f_hi - f_lo > 1e-6 do   -- bisection
-    local f = 0.5 * (f_lo + f_hi)
+  -- Above jamming the stress of a packing grows about linearly with the radius factor: where both
+  -- ends of the bracket carry stress, the line through them finds the target in a few steps
+  -- (regula falsi, halving the weight of an end kept twice: Illinois). Below jamming (no stress at
+  -- the lower end) the line says nothing: bisection.
+  local kept_side
+  while not good(p) and iterations < max_it and f_hi - f_lo > 1e-7 do
+    local f
+    if p_lo > 0 then
+      f = f_lo + (target - p_lo) * (f_hi - f_lo) / (p_hi - p_lo)
+      if not (f > f_lo and f < f_hi) then f = 0.5 * (f_lo + f_hi) end
+    else
+      f = 0.5 * (f_lo + f_hi)
+    end
     p = stress_at(f)
-    if p > target then f_hi = f else f_lo = f end
+    if p > target then
+      f_hi, p_hi = f, p
+      if kept_side == "lo" and p_lo > 0 then p_lo = 0.5 * (p_lo + target) end
+      kept_side = "lo"
+    else
+      f_lo, p_lo = f, p
+      if kept_side == "hi" then p_hi = 0.5 * (p_hi + target) end
+      kept_side = "hi"
+    end
   end
   return {factor = f_now, stress = p, iterations = iterations, steps = steps, reached = good(p)}
 end
