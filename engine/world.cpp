@@ -580,6 +580,28 @@ ContactSummary World::contact_summary(int tag_a, int tag_b, std::uint8_t flag_ma
   return out;
 }
 
+World::ContactStress World::contact_stress(int tag, double volume) const {
+  require(volume > 0 && std::isfinite(volume), "contact_stress: volume must be > 0 (m^3), got " + num(volume));
+  const State& s = *state_;
+  const auto& p = s.p;
+  const auto& q = s.pairs;
+  ContactStress out;
+  const double kn = s.settings.contact.kn;
+  for (std::size_t k = 0; k < q.n; ++k) {
+    const double U = q.overlap_at(k);
+    if (!(U > 0)) continue;
+    const auto a = q.a[k], b = q.b[k];
+    if (p.tag[a] != tag || p.tag[b] != tag) continue;
+    const double reach = p.radius[a] + p.radius[b];
+    out.stress += q.normal_force(k) * (reach - U);
+    out.stiffness += kn * reach * (reach - U);
+    ++out.contacts;
+  }
+  out.stress /= 3 * volume;
+  out.stiffness /= 3 * volume;
+  return out;
+}
+
 // --- bonds ---------------------------------------------------------------------------------
 
 std::size_t World::install_bonds(const BondMaterial& material, double tolerance,

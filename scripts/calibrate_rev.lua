@@ -138,6 +138,11 @@ if P.isotropy then
                 100 * result.young_modulus_spread_of_means, result.poisson_ratio_x.mean, result.poisson_ratio_y.mean,
                 result.poisson_ratio_z.mean, 100 * result.poisson_ratio_spread_of_means))
 end
-print(("put into scripts/lib/materials.lua M.rev: young_modulus = %.5g, bond_tensile_strength = %.5g")
-      :format(result.young_modulus_pa.mean, result.bond_tensile_strength_pa))
+local record = {seeds = seeds}
+for _, key in ipairs{"young_modulus_pa", "poisson_ratio", "tensile_strength_mpa", "compressive_strength_mpa",
+                     "strength_ratio"} do
+  record[key] = {mean = result[key].mean, sd = result[key].sd}
+end
+print(("put into scripts/lib/materials.lua M.rev: young_modulus = %.5g, bond_tensile_strength = %.5g,\n  calibration = %s")
+      :format(result.young_modulus_pa.mean, result.bond_tensile_strength_pa, require("genesis").serialise(record)))
 return result

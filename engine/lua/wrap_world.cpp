@@ -621,6 +621,19 @@ int world_contact_summary(lua_State* L) {
   });
 }
 
+int world_contact_stress(lua_State* L) {
+  return guarded(L, [&] {
+    World& w = world_arg(L);
+    int tag = static_cast<int>(check_integer(L, 2));
+    double volume = luaL_checknumber(L, 3);
+    const World::ContactStress c = w.contact_stress(tag, volume);
+    lua_pushnumber(L, c.stress);
+    lua_pushnumber(L, c.stiffness);
+    lua_pushinteger(L, static_cast<lua_Integer>(c.contacts));
+    return 3;
+  });
+}
+
 // ---------------------------------------------------------------------------------------------
 // Bonds
 
@@ -1275,6 +1288,11 @@ void open_world(lua_State* L) {
        "world:contact_summary(tag_a, tag_b [, flag_mask]) -> {count, area, force, flagged_count, flagged_force}",
        "Touching contacts between two tags: number, contact area (sum pi a^2, m^2, [4-1]), total\n"
        "force on the tag_b particles; flagged_*: those involving a particle with flag_mask bits."},
+      {"contact_stress", world_contact_stress, "world:contact_stress(tag, volume) -> Pa, Pa, n",
+       "Mean stress of the particles of a tag from their touching contacts (Love-Weber):\n"
+       "sum Fn d / (3 volume), d the distance of the centres; compression positive. Then its affine\n"
+       "stiffness against a common radius factor f, dp/df = sum kn (Ra + Rb) d / (3 volume), and\n"
+       "the number of those contacts."},
       // bonds
       {"install_bonds", world_install_bonds,
        "world:install_bonds{tensile_strength= | breakable=false [, beam_kn=] [, beam_ks=]\n"

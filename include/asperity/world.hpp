@@ -256,6 +256,14 @@ class World {
   void set_flags(std::span<const std::int64_t> ids, std::uint8_t flags);
   std::uint8_t flags(std::int64_t id) const;
   ContactSummary contact_summary(int tag_a, int tag_b, std::uint8_t flag_mask = 0) const;
+  // Mean stress of the particles of one tag from their touching ball-ball contacts (Love-Weber):
+  // sum Fn d / (3 volume), d the distance of the two centres; compression positive, Pa. And its
+  // affine stiffness against a common radius factor f: dp/df = sum kn (Ra + Rb) d / (3 volume).
+  struct ContactStress {
+    double stress = 0, stiffness = 0;
+    std::size_t contacts = 0;
+  };
+  ContactStress contact_stress(int tag, double volume) const;
 
   // --- bonds (model.md 5) ----------------------------------------------------------------
   // Bond every pair whose gap d - Ra - Rb <= tolerance (tolerance < 0: 1e-3 x mean radius), at

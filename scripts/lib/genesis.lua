@@ -13,9 +13,10 @@
 --      tenth of the radii, radii grown in stages (pack.expand). A frictionless assembly jams
 --      denser than a frictional one and at a reproducible density, so the state below does not
 --      depend on where a frictional packing happened to lock.
---   2. a low isotropic stress installed by scaling the radii by one factor (M.install_stress)
---      until the mean stress of the assembly (from its contacts, M.contact_stresses) is `stress`;
---      with `split(x, y, z)` -> 1..sets_count, each set (the halves of a joint) has its own factor.
+--   2. a low isotropic stress installed by scaling the radii by one factor (M.install_stress, a
+--      servo) until the mean stress of the assembly (from its contacts, world:contact_stress) is
+--      `stress`; with `split(x, y, z)` -> 1..sets_count, each set (the halves of a joint) has its
+--      own factor. The particles of set k are tagged k.
 --   3. floaters (fewer than `min_contacts` contacts with particles and walls: rattlers of the
 --      jammed assembly, which carry nothing and would get no bond that holds them) are taken out
 --      of the specimen: made inert, fixed, and tagged `floater_tag` if given. Wall contacts are
@@ -49,107 +50,71 @@ function M.contact_counts(world)
   return counts
 end
 
--- Mean stress of an assembly from its ball-ball contacts (Love-Weber): p = sum Fn d / (3 V), d the
--- distance of the two centres, over the contacts whose both particles are in `member` (a table
--- id -> set index) and of set `k`, or all. Unlike the wall stress it does not count particles wedged
--- between a wall and the mould, and it is the stress the bonds inherit.
-function M.contact_stresses(world, member, volumes)
-  local r = world:radii()
-  local sums = {}
-  for k = 1, #volumes do sums[k] = 0 end
-  for _, c in ipairs(world:contacts()) do
-    local k = member[c.a]
-    if k and member[c.b] == k then
-      sums[k] = sums[k] + c.normal_force * (r:get(c.a) + r:get(c.b) - c.overlap)
-    end
-  end
-  for k = 1, #volumes do sums[k] = sums[k] / (3 * volumes[k]) end
-  return sums
-end
-
 -- The isotropic stress installation [scenarios.md 1; Potyondy & Cundall 2004]: the radii of each
--- set scaled by one factor of its own until its mean stress is `target` within `tolerance`,
--- cycling to equilibrium after each change. Sets that do not touch (the halves of a joint, apart
--- behind the mould) are independent and are searched together, one cycling per iteration. Per set:
--- the factor is bracketed (steps from 1e-3, doubling), then found by regula falsi where both ends
--- carry stress (above jamming the stress grows about linearly with the factor; Illinois: an end
--- kept twice has its weight halved) and by bisection where the lower end carries none.
+-- set (its particles tagged `tags[k]`) scaled by a factor of its own until its mean stress
+-- (world:contact_stress) is `target`, as a servo: every `every` steps each factor moves by
+-- gain (target - p) / (dp/df), dp/df the affine stiffness of the set's contacts (an upper bound of
+-- the true one, which relaxes non-affinely, so the loop does not overshoot), at most `max_change`
+-- per update. Sets that do not touch (the halves of a joint, apart behind the mould) are servoed
+-- side by side. Near the jamming point a frictionless packing relaxes slowly; the servo follows
+-- the relaxation instead of waiting for an equilibrium at each trial factor. Done when every set
+-- is within `tolerance` of the target at `settled` updates running and the unbalanced-force
+-- ratio is below `ratio`.
 function M.install_stress(world, o)
-  local sets, volumes, target = o.sets, o.volumes, o.target
+  local sets, tags, volumes, target = o.sets, o.tags, o.volumes, o.target
   local tol, ratio = o.tolerance or 0.1, o.ratio or 1e-4
-  local member = {}
-  for k, ids in ipairs(sets) do for _, id in ipairs(ids) do member[id] = k end end
-  local st = {}
-  for k = 1, #sets do st[k] = {f = 1, step = 1e-3, done = false} end
-  local steps, iterations = 0, 0
-  local function cycle_and_measure()
-    pack.refresh_dt(world)
-    steps = steps + 1 + world:run{steps = o.max_steps or 200000, every = 100, stop_when = function(w)
-      return w:unbalanced_force_ratio() <= ratio or (w:contact_count() == 0 and w:stats().wall_contacts == 0)
-    end}
-    iterations = iterations + 1
-    return M.contact_stresses(world, member, volumes)
+  local every, gain, max_change = o.every or 200, o.gain or 0.5, o.max_change or 2e-3
+  local settled_needed = o.settled or 5
+  local f, p, stiff = {}, {}, {}
+  for k = 1, #sets do f[k] = 1 end
+  local steps, updates, settled = 0, 0, 0
+  local max_steps = o.max_steps or 1000000
+  local function measure()
+    for k = 1, #sets do p[k], stiff[k] = world:contact_stress(tags[k], volumes[k]) end
   end
-  local function good(p) return math.abs(p - target) <= tol * target end
-  local function record(s, f, p)
-    if p > target then
-      if s.kept == "lo" and s.p_lo and s.p_lo > 0 then s.p_lo = 0.5 * (s.p_lo + target) end
-      s.f_hi, s.p_hi, s.kept = f, p, "lo"
-    else
-      if s.kept == "hi" and s.p_hi then s.p_hi = 0.5 * (s.p_hi + target) end
-      s.f_lo, s.p_lo, s.kept = f, p, "hi"
-    end
-    s.p = p
-    s.done = good(p)
+  local function good()
+    for k = 1, #sets do if math.abs(p[k] - target) > tol * target then return false end end
+    return true
   end
-  local p = cycle_and_measure()
-  for k, s in ipairs(st) do
-    record(s, 1, p[k])
-    s.kept = nil
-  end
-  local max_it = o.iterations or 40
-  while iterations < max_it do
-    local busy = false
-    for k, s in ipairs(st) do
-      if not s.done then
-        local f
-        if not (s.f_lo and s.f_hi) then                       -- bracket
-          f = s.f_hi and s.f_hi * (1 - s.step) or s.f_lo * (1 + s.step)
-          s.step = s.step * 2
-        elseif s.f_hi - s.f_lo <= 1e-7 then
-          f = nil                                              -- as close as it gets
-        elseif s.p_lo > 0 then                                 -- regula falsi
-          f = s.f_lo + (target - s.p_lo) * (s.f_hi - s.f_lo) / (s.p_hi - s.p_lo)
-          if not (f > s.f_lo and f < s.f_hi) then f = 0.5 * (s.f_lo + s.f_hi) end
-        else
-          f = 0.5 * (s.f_lo + s.f_hi)
-        end
-        if f then
-          local change = f / s.f
-          for _, id in ipairs(sets[k]) do world:set_radius(id, world:radius(id) * change) end
-          s.f, busy = f, true
-        else
-          s.done = true
-        end
+  pack.refresh_dt(world)
+  measure()
+  while steps < max_steps do
+    local changed = false
+    for k = 1, #sets do
+      local df
+      if stiff[k] > 0 then
+        df = gain * (target - p[k]) / stiff[k]
+      else
+        df = max_change      -- no contact in the set: grow towards jamming
+      end
+      df = math.max(-max_change, math.min(max_change, df))
+      if math.abs(p[k] - target) > 0.25 * tol * target or stiff[k] == 0 then
+        local change = (f[k] + df) / f[k]
+        for _, id in ipairs(sets[k]) do world:set_radius(id, world:radius(id) * change) end
+        f[k], changed = f[k] + df, true
       end
     end
-    if not busy then break end
-    p = cycle_and_measure()
-    for k, s in ipairs(st) do if not s.done then record(s, s.f, p[k]) elseif s.p then s.p = p[k] end end
+    if changed then pack.refresh_dt(world) steps = steps + 1 end
+    steps = steps + world:cycle(every)
+    updates = updates + 1
+    measure()
+    if good() then settled = settled + 1 else settled = 0 end
+    if o.log and updates % 25 == 0 then
+      local t = {}
+      for k = 1, #sets do t[k] = ("x %.5f: %.4g Pa"):format(f[k], p[k]) end
+      o.log("  stress installation, %d steps: %s; ratio %.2g", steps, table.concat(t, ", "), world:unbalanced_force_ratio())
+    end
+    if settled >= settled_needed and world:unbalanced_force_ratio() <= ratio then break end
   end
-  local out = {iterations = iterations, steps = steps, factors = {}, stresses = {}, reached = true}
-  for k, s in ipairs(st) do
-    out.factors[k], out.stresses[k] = s.f, p[k]
-    out.reached = out.reached and good(p[k])
-  end
-  return out
+  return {steps = steps, updates = updates, factors = f, stresses = p, reached = good()}
 end
 
 function M.pack(world, o)
   check(o, {min = true, max = true, inside = true, radii = true, seed = true, box = true, walls = true,
             volume = true, stress = true, tolerance = true, friction = true, ratio = true,
             min_contacts = true, floater_tag = true, progress = true, stages = true, stage_steps = true,
-            max_steps = true, log = true, wall_contacts = true, split = true, sets_count = true}, "genesis.pack")
+            max_steps = true, log = true, wall_contacts = true, split = true, sets_count = true,
+            compaction_ratio = true, compaction_steps = true}, "genesis.pack")
   assert(o.min and o.max and o.radii and o.box, "genesis.pack: min, max, radii and box are required")
   assert(o.stress and o.stress > 0, "genesis.pack: stress (Pa, > 0) is required")
   local log = o.log or function() end
@@ -157,10 +122,11 @@ function M.pack(world, o)
   local ratio = o.ratio or 1e-4
   -- 1. Frictionless compaction.
   world:set_friction(0)
+  -- The compaction need not settle finely: the stress installation that follows does.
   local expanded = pack.expand(world, {min = o.min, max = o.max, inside = o.inside, radii = o.radii,
-                                       seed = o.seed, walls = o.box, volume = o.volume, ratio = ratio,
+                                       seed = o.seed, walls = o.box, volume = o.volume, ratio = o.compaction_ratio or 1e-3,
                                        progress = o.progress, stages = o.stages, stage_steps = o.stage_steps,
-                                       max_steps = o.max_steps})
+                                       max_steps = o.compaction_steps or 5000})
   local first, last = expanded.first, expanded.last
   local volume = o.volume or (o.max[1] - o.min[1]) * (o.max[2] - o.min[2]) * (o.max[3] - o.min[3])
   -- The sets searched on their own: `split(x, y, z)` -> set index (the halves of a joint), or one.
@@ -171,20 +137,23 @@ function M.pack(world, o)
     local k = o.split and o.split(pos0:get(id, 1), pos0:get(id, 2), pos0:get(id, 3)) or 1
     table.insert(sets[k], id)
   end
-  local volumes = {}
-  for k = 1, nsets do volumes[k] = volume / nsets end
-  local member = {}
-  for k, ids in ipairs(sets) do for _, id in ipairs(ids) do member[id] = k end end
-  local p0 = M.contact_stresses(world, member, volumes)
+  local volumes, tags = {}, {}
+  for k = 1, nsets do
+    volumes[k], tags[k] = volume / nsets, k
+    world:set_tag(sets[k], k)
+  end
+  local p0 = {}
+  for k = 1, nsets do p0[k] = world:contact_stress(k, volumes[k]) end
   log("compacted %d particles without friction in %d steps: mean stress %s Pa, coordination %.2f",
       last - first + 1, expanded.steps, table.concat((function() local t = {} for k, v in ipairs(p0) do t[k] = ("%.4g"):format(v) end return t end)(), " / "), expanded.coordination)
   -- 2. The isotropic stress, by one radius factor per set.
-  local s = M.install_stress(world, {sets = sets, volumes = volumes, target = o.stress, tolerance = o.tolerance,
-                                     ratio = ratio, max_steps = o.max_steps})
+  local s = M.install_stress(world, {sets = sets, tags = tags, volumes = volumes, target = o.stress,
+                                     tolerance = o.tolerance, ratio = ratio, max_steps = o.max_steps,
+                                     log = o.progress and log or nil})
   local fs, ps = {}, {}
   for k = 1, nsets do fs[k], ps[k] = ("%.5f"):format(s.factors[k]), ("%.4g"):format(s.stresses[k]) end
-  log("stress installed: radii x %s, mean stress %s Pa (target %.4g) after %d iterations, %d steps%s",
-      table.concat(fs, " / "), table.concat(ps, " / "), o.stress, s.iterations, s.steps,
+  log("stress installed: radii x %s, mean stress %s Pa (target %.4g) in %d steps%s",
+      table.concat(fs, " / "), table.concat(ps, " / "), o.stress, s.steps,
       s.reached and "" or " (NOT reached)")
   -- 3. Floaters out. A particle's contacts with the region's walls count: one held by two
   -- neighbours against a wall is part of the jammed structure (its bonds will hold it once the
