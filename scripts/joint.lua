@@ -44,7 +44,9 @@ local P = require("params").defaults{
   quasi_static_limit = 0.01, -- warn when the kinetic energy exceeds this x normal load x mean radius
   overlap_limit = 0.5,     -- warn when a contact overlaps this fraction of the smaller radius (the engine
                            -- stops at 1): the contacts are too soft for the load (perf/README.md)
-  normal_control = "servo", -- servo (model.md 7, with integral action) or load: a constant force on a free platen
+  normal_control = "servo", -- servo (model.md 7, with integral action), load: a constant force on a free platen,
+                           -- or stiffness: constant normal stiffness, sigma_0 + normal_stiffness x dilatancy
+  normal_stiffness = 0,    -- MPa/mm (scaled) of normal_control=stiffness
   platen_damping = 0,      -- local damping of the dead-load platen (< 0: the world's)
   servo_relaxation = 0.4,  -- servo gain: fraction of the force error the platen contacts correct per step
   servo_integral_steps = 2, -- integral time of the servo, in time steps (0: proportional only, model.md 7)
@@ -94,6 +96,12 @@ if P.stop_after ~= "" and P.stop_after ~= "packing" then
 end
 for _, key in ipairs{"quasi_static_limit", "overlap_limit"} do
   if not (P[key] > 0) then error(("%s must be > 0, got %s"):format(key, tostring(P[key]))) end
+end
+-- Constant normal stiffness: a stiffness is what makes it one (0 would be the servo's CNL).
+if P.normal_control == "stiffness" and not (P.normal_stiffness > 0 and P.normal_stiffness < math.huge) then
+  error(("normal_stiffness must be > 0 MPa/mm with normal_control=stiffness, got %s"):format(tostring(P.normal_stiffness)), 0)
+elseif P.normal_control ~= "stiffness" and P.normal_stiffness ~= 0 then
+  error(("normal_stiffness=%s needs normal_control=stiffness (now '%s')"):format(tostring(P.normal_stiffness), P.normal_control), 0)
 end
 local t_start = asperity.wall_time()
 asperity.mkdir(P.out)
@@ -485,9 +493,15 @@ shear_velocity[axis] = -P.velocity
 -- noise): it follows any dilatancy at once and the load it transmits differs from the target only
 -- by its inertia. "servo" (model.md 7): the platen's z velocity follows the force error, with
 -- integral action (servo_integral_steps) so that a steady dilatancy rate leaves no lag.
-local modes = {"fixed", "fixed", P.normal_control == "servo" and "servo" or "free"}
+-- "stiffness": the same servo, its target rising by normal_stiffness x the platen's rise (constant
+-- normal stiffness, the engine's servo `stiffness`); it settles on sigma_0 like the CNL servo, and
+-- the stiffness is switched on when the shear starts, so the dilatancy it acts on is the recorded one.
+local servo_control = P.normal_control == "servo" or P.normal_control == "stiffness"
+local modes = {"fixed", "fixed", servo_control and "servo" or "free"}
 modes[axis] = "velocity"
-if P.normal_control == "servo" then
+-- MPa/mm scaled -> N/m of the platen: model Pa per m of rise, times the area.
+local cns_stiffness = P.normal_control == "stiffness" and P.normal_stiffness * 1e6 / stress_scale * 1e3 * area or 0
+if servo_control then
   world:set_group_motion(top, {translation = modes, velocity = shear_velocity,
                                servo = {target_force = target_stress * area, max_velocity = P.servo_max_velocity * P.velocity,
                                         relaxation = P.servo_relaxation,
@@ -497,7 +511,7 @@ elseif P.normal_control == "load" then
   applied_z = -target_stress * area
   world:set_group_force(top, {0, 0, applied_z})
 else
-  error("normal_control must be load or servo, got '" .. P.normal_control .. "'")
+  error("normal_control must be servo, load or stiffness, got '" .. P.normal_control .. "'")
 end
 -- Let the platen settle on the target load before shearing.
 do
@@ -577,6 +591,7 @@ local function set_shear_velocity(stage)
   v[axis] = -P.velocity * math.min(1, stage / ramp_stages)
   world:set_group_motion(top, {translation = modes, velocity = v})
 end
+if cns_stiffness > 0 then world:set_group_motion(top, {servo = {stiffness = cns_stiffness}}) end
 set_shear_velocity(1)
 local stage = 1
 world:run{steps = 100000000, every = record_every, progress = P.progress,
@@ -656,10 +671,13 @@ end
 local q = fit(lx, ly)
 local sn_mean = shear:column("normal_stress_mean_mpa")
 local sn_dev, sn_dev_mean, devs = 0, 0, {}
+-- The stress the control asks for: sigma_0, or with constant normal stiffness sigma_0 + K dilatancy
+-- (for an interval mean, at the interval's mean dilatancy).
+local K_cns = P.normal_control == "stiffness" and P.normal_stiffness or 0
 for k = 1, rows do
   if u[k] > 0.05 then
-    sn_dev = math.max(sn_dev, math.abs(sn[k] / P.stress - 1))
-    devs[#devs + 1] = math.abs(sn_mean[k] / P.stress - 1)
+    sn_dev = math.max(sn_dev, math.abs(sn[k] / (P.stress + K_cns * dil[k]) - 1))
+    devs[#devs + 1] = math.abs(sn_mean[k] / (P.stress + K_cns * 0.5 * (dil[k] + dil[math.max(1, k - 1)])) - 1)
     sn_dev_mean = math.max(sn_dev_mean, devs[#devs])
   end
 end
