@@ -78,6 +78,7 @@ local P = require("params").defaults{
   simd = "auto",           -- kernels of closure and shear: auto, an architecture, or "float" (the force laws
                            -- in single precision, scalar: perf/runtime_vs_error.lua's study); packing: auto
   progress = true,
+  events_every = 0,        -- steps between energy samples for the event statistics (events.{h5,csv}); 0: none
   save = "",               -- a path: the world's checkpoint when the shear ends (to continue from it,
                            -- or to time the shear step in one process: perf/README.md, perf/ab.sh)
   stop_after = "",         -- "packing": stop once the halves are packed, before bonding (the world
@@ -583,6 +584,20 @@ local function record_shear()
 end
 record_shear()
 local record_every = math.max(1, math.floor(P.record * 1e-3 / (P.velocity * world:dt()) + 0.5))
+-- Event statistics (scenarios.md 8): the energies every `events_every` steps while shearing; the
+-- breaks themselves come from world:break_events. The run then calls back every step, so the records
+-- and the velocity ramp keep their steps and the run its results.
+local events, sample_every, breaks_before = nil, record_every, world:break_count()
+if P.events_every > 0 then
+  sample_every = 1
+  events = asperity.series{"step [1]", "displacement [mm]", "broken_bonds [1]", "kinetic [J]", "strain [J]",
+                           "damping [J]", "friction [J]", "released [J]"}
+end
+local function record_events()
+  local en = world:energies()
+  events:record(world:step(), displacement(), world:break_count() - breaks_before, en.kinetic, en.strain,
+                en.damping, en.friction, en.released)
+end
 local shear_t0, shear_s0, shear_r0 = asperity.wall_time(), world:step(), world:stats().rebuilds
 -- The shear velocity rises linearly over `ramp` mm (time 2 ramp / v), in one stage per record.
 local ramp_stages = P.ramp > 0 and math.max(1, math.ceil(2 * P.ramp * 1e-3 / P.velocity / world:dt() / record_every)) or 1
@@ -594,8 +609,14 @@ end
 if cns_stiffness > 0 then world:set_group_motion(top, {servo = {stiffness = cns_stiffness}}) end
 set_shear_velocity(1)
 local stage = 1
-world:run{steps = 100000000, every = record_every, progress = P.progress,
+if events then record_events() end
+world:run{steps = 100000000, every = sample_every, progress = P.progress,
           callback = function()
+            if events then
+              local k = world:step() - shear_s0
+              if k % P.events_every == 0 then record_events() end
+              if k % record_every ~= 0 then return end
+            end
             record_shear()
             if stage < ramp_stages then stage = stage + 1; set_shear_velocity(stage) end
           end,
@@ -618,6 +639,19 @@ end
 local shear_seconds, shear_steps = asperity.wall_time() - shear_t0, world:step() - shear_s0
 local shear_rebuilds = world:stats().rebuilds - shear_r0
 shear:write(P.out .. "/shear")
+if events then events:write(P.out .. "/events") end
+-- Every bond break while shearing (model.md 5), for the event statistics and maps.
+if world:break_count() > breaks_before then
+  local breaks = asperity.series{"step [1]", "time [s]", "x [m]", "y [m]", "z [m]", "mode [1]", "sigma [Pa]",
+                                 "tau [Pa]", "released_energy [J]"}
+  breaks:set_attribute("mode", "1 tension, 2 compression, 3 shear")
+  local mode_code = {tension = 1, compression = 2, shear = 3}
+  for _, ev in ipairs(world:break_events(breaks_before + 1)) do
+    breaks:record(ev.step, ev.time, ev.position[1], ev.position[2], ev.position[3], mode_code[ev.mode] or 0,
+                  ev.sigma, ev.tau, ev.released_energy)
+  end
+  breaks:write(P.out .. "/breaks")
+end
 log("sheared %.2f mm", displacement())
 
 -- 8. Summary --------------------------------------------------------------------------------
