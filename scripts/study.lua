@@ -29,6 +29,7 @@ local P = require("params").defaults{
   seeds = "1",                -- surface realisations (one phase field per seed, shared by S1..S8)
   size = 0,                   -- side of the joints, m (0: joint.lua's default)
   normal_stiffness = 0,       -- MPa/mm: constant normal stiffness (0: constant normal load)
+  events_every = 100,         -- steps between the energy samples of the fracture runs (event statistics; 0: none)
   joint = "",                 -- more key=value parameters for every joint.lua run, space-separated
   out = "out/study",
   jobs = 0,                   -- runs at once (0: the machine's cores / threads)
@@ -79,11 +80,14 @@ if not (P.size >= 0) then fail("size must be >= 0 m (0: joint.lua's default), go
 if not (P.normal_stiffness >= 0 and P.normal_stiffness < math.huge) then
   fail("normal_stiffness must be >= 0 MPa/mm (0: constant normal load), got %s", tostring(P.normal_stiffness))
 end
+if math.type(P.events_every) ~= "integer" or P.events_every < 0 then
+  fail("events_every must be a whole number of steps >= 0 (0: no energy samples), got %s", tostring(P.events_every))
+end
 if not (P.poll > 0) then fail("poll must be > 0 s, got %s", tostring(P.poll)) end
 -- What the runner sets itself may not be given again through `joint`.
 local reserved = {surface = true, stress = true, direction = true, model = true, seed = true, out = true,
                   threads = true, cache = true, size = true, progress = true, normal_control = true,
-                  normal_stiffness = true}
+                  normal_stiffness = true, events_every = true}
 local extra = {}
 for item in P.joint:gmatch("%S+") do
   local k, v = item:match("^([%a_][%w_]*)=(.*)$")
@@ -165,6 +169,7 @@ local function command(run)
     args[#args + 1] = "normal_control=stiffness"
     args[#args + 1] = ("normal_stiffness=%.17g"):format(P.normal_stiffness)
   end
+  if run.model == "fracture" and P.events_every > 0 then args[#args + 1] = "events_every=" .. P.events_every end
   for _, item in ipairs(extra) do args[#args + 1] = item end
   args[#args + 1] = "threads=" .. threads
   args[#args + 1] = "progress=false"
