@@ -405,6 +405,24 @@ end
 
 asperity.mkdir(DIR .. "/.study")
 write_atomic(DIR .. "/.study/run.sh", RUN_SH)
+-- The run names do not carry the settings every run shares, so a folder holds one study: a later
+-- invocation with other settings would skip runs made differently and mix them in one table.
+do
+  local settings = {size = P.size, joint = table.concat(extra, " "), normal_stiffness = P.normal_stiffness,
+                    events_every = P.events_every}
+  local path = DIR .. "/.study/settings.json"
+  if exists(path) then
+    local before = json.read(path)
+    for _, k in ipairs{"size", "joint", "normal_stiffness", "events_every"} do
+      if before[k] ~= settings[k] then
+        fail("%s holds a study made with %s=%s, not %s: give another out= (or the same %s)", DIR, k,
+             tostring(before[k]), tostring(settings[k]), k)
+      end
+    end
+  else
+    write_atomic(path, asperity.json(settings))
+  end
+end
 
 -- slurm=FILE: a job array instead of running ----------------------------------------------------
 -- Two arrays: the packers (one run per surface and seed, which packs and caches the specimen),
