@@ -521,7 +521,7 @@ local function events(dir, rows, log)
     lines = {"size,events_at_least"}
     for k = 1, #xs do lines[#lines + 1] = xs[k] .. "," .. ns[k] end
     write_atomic(("%s/%s_sizes.csv"):format(edir, a.name), table.concat(lines, "\n") .. "\n")
-    size_series[#size_series + 1] = {title = a.name, x = xs, y = ns, style = "linespoints", point = 7, size = 0.6}
+    size_series[#size_series + 1] = {title = "", x = xs, y = ns, style = "linespoints", point = 7, size = 0.6, width = 1}
     for _, s in ipairs(a.sizes) do pooled_sizes[#pooled_sizes + 1] = s end
     for _, e in ipairs(a.event_energy) do if e > 0 then pooled_mags[#pooled_mags + 1] = math.log(e, 10) end end
     if a.xcorr then
@@ -556,7 +556,8 @@ local function events(dir, rows, log)
   size_series[#size_series + 1] = {title = ("pooled: b = %.2f +- %.2f (%d events)"):format(pb, pe, pn), x = xs, y = ns,
                                    style = "linespoints", color = "#000000", point = 5, width = 3}
   fig.curves{file = edir .. "/sizes.png", logx = true, logy = true, xlabel = "event size S [broken bonds]",
-             ylabel = "events with size >= S", title = "break events (M = log10 S)", series = size_series}
+             ylabel = "events with size >= S", title = "break events (M = log10 S): each fracture run (thin), pooled (black)",
+             series = size_series, key = "top right"}
   local out = {runs = #results, sampled_runs = sampled, pooled_events = #pooled_sizes, pooled_b = pb, pooled_b_error = pe,
                pooled_b_energy = pbe, pooled_b_energy_error = pee,
                magnitude = "M = log10 S, S the bonds broken in one event (consecutive intervals with breaks); " ..
