@@ -40,6 +40,7 @@ local P = require("params").defaults{
   report = true,              -- false: tables only (no trends, plots, event statistics)
   asperity = "",              -- the program each run uses (default: the one running this script)
   poll = 0.5,                 -- s between looks at the running jobs
+  heartbeat = 600,            -- s between progress lines while runs go on (0: only at starts and ends)
 }
 
 local function log(fmt, ...) io.stderr:write(("[study] " .. fmt .. "\n"):format(...)) end
@@ -84,6 +85,7 @@ if math.type(P.events_every) ~= "integer" or P.events_every < 0 then
   fail("events_every must be a whole number of steps >= 0 (0: no energy samples), got %s", tostring(P.events_every))
 end
 if not (P.poll > 0) then fail("poll must be > 0 s, got %s", tostring(P.poll)) end
+if not (P.heartbeat >= 0) then fail("heartbeat must be >= 0 s (0: none), got %s", tostring(P.heartbeat)) end
 -- What the runner sets itself may not be given again through `joint`.
 local reserved = {surface = true, stress = true, direction = true, model = true, seed = true, out = true,
                   threads = true, cache = true, size = true, progress = true, normal_control = true,
@@ -547,15 +549,22 @@ local function estimate(run, packs)
     for _, v in ipairs(t) do s = s + v end
     return s / #t
   end
-  return mean(run.model .. (packs and "+pack" or "")) or mean(run.model) or mean("any")
+  if packs then return mean(run.model .. "+pack") or mean("any+pack") or mean(run.model) or mean("any") end
+  return mean(run.model) or mean("any") or mean(run.model .. "+pack") or mean("any+pack")
 end
 
 local running, done, failed_now = {}, 0, 0
+local last_heartbeat = asperity.wall_time()
 local function started_count() local n = 0 for _ in pairs(running) do n = n + 1 end return n end
 local function overall_left()
   local total, known = 0, true
+  -- One packer for each group not packed yet (unless one is running), the others after it.
+  local packing = {}
+  for _, job in pairs(running) do if job.packs then packing[job.run.group] = true end end
   for _, run in ipairs(pending) do
-    local e = estimate(run, not ready[run.group])
+    local packs = not ready[run.group] and not packing[run.group]
+    if packs then packing[run.group] = true end
+    local e = estimate(run, packs)
     if e then total = total + e else known = false end
   end
   local now = asperity.wall_time()
@@ -563,7 +572,7 @@ local function overall_left()
     local e = estimate(job.run, job.packs)
     if e then total = total + math.max(0, e - (now - job.t)) else known = false end
   end
-  if not known then return "?" end
+  if not known then return "an unknown time" end
   return clock(total / jobs)
 end
 
@@ -574,9 +583,10 @@ local function start(run, packs)
   if not pid then fail("could not start the run %s", run.name) end
   running[run.name] = {run = run, pid = pid, t = asperity.wall_time(), packs = packs}
   local e = estimate(run, packs)
-  log("started %s%s%s (%d of %d); expected %s", run.name, packs and " (packs the specimen)" or "",
+  log("started %s%s%s (%d of %d); %s", run.name, packs and " (packs the specimen)" or "",
       run.restart and " (again: it was interrupted)" or "", done + started_count(), todo,
-      e and ("in about " .. clock(e)) or "time unknown yet")
+      e and ("expected to end at %s (in about %s)"):format(os.date("%H:%M", os.time() + math.floor(e + 0.5)), clock(e))
+        or "no estimate yet")
 end
 
 -- A wrapper is alive while /proc/PID is its run.sh (the pid of an ended one may be reused).
@@ -611,6 +621,14 @@ while #pending > 0 or next(running) do
     start(run, packs)
   end
   sleep(P.poll)
+  -- Between starts and ends of long runs: where the study stands, every `heartbeat` seconds.
+  if P.heartbeat > 0 and asperity.wall_time() - last_heartbeat >= P.heartbeat then
+    last_heartbeat = asperity.wall_time()
+    local now, names = asperity.wall_time(), {}
+    for name, job in pairs(running) do names[#names + 1] = ("%s %s"):format(name, clock(now - job.t)) end
+    table.sort(names)
+    log("%d of %d ended, running: %s; about %s left", done, todo, table.concat(names, ", "), overall_left())
+  end
   local ended = {}
   for name, job in pairs(running) do
     if not alive(job) then ended[#ended + 1] = name end
@@ -625,7 +643,7 @@ while #pending > 0 or next(running) do
     if state == "finished" then
       ready[job.run.group] = true
       local key = job.run.model .. (job.packs and "+pack" or "")
-      for _, k in ipairs{key, job.run.model, "any"} do
+      for _, k in ipairs{key, job.packs and "any+pack" or "any"} do
         times[k] = times[k] or {}
         table.insert(times[k], seconds)
       end
