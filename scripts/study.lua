@@ -614,54 +614,70 @@ local function next_run()
   return nil
 end
 
-while #pending > 0 or next(running) do
-  while started_count() < jobs do
-    local run, packs = next_run()
-    if not run then break end
-    start(run, packs)
-  end
-  sleep(P.poll)
-  -- Between starts and ends of long runs: where the study stands, every `heartbeat` seconds.
-  if P.heartbeat > 0 and asperity.wall_time() - last_heartbeat >= P.heartbeat then
-    last_heartbeat = asperity.wall_time()
-    local now, names = asperity.wall_time(), {}
-    for name, job in pairs(running) do names[#names + 1] = ("%s %s"):format(name, clock(now - job.t)) end
-    table.sort(names)
-    log("%d of %d ended, running: %s; about %s left", done, todo, table.concat(names, ", "), overall_left())
-  end
-  local ended = {}
-  for name, job in pairs(running) do
-    if not alive(job) then ended[#ended + 1] = name end
-  end
-  table.sort(ended)
-  for _, name in ipairs(ended) do
-    local job = running[name]
-    running[name] = nil
-    local seconds = asperity.wall_time() - job.t
-    local state = state_of(name)
-    done = done + 1
-    if state == "finished" then
-      ready[job.run.group] = true
-      local key = job.run.model .. (job.packs and "+pack" or "")
-      for _, k in ipairs{key, job.packs and "any+pack" or "any"} do
-        times[k] = times[k] or {}
-        table.insert(times[k], seconds)
-      end
-      local ok, s = pcall(json.read, DIR .. "/" .. name .. "/summary.json")
-      local what = ok and type(s.peak_shear_stress_mpa) == "number" and type(s.residual_shear_stress_mpa) == "number"
-                   and (": peak %.2f MPa, residual %.2f MPa"):format(s.peak_shear_stress_mpa, s.residual_shear_stress_mpa) or ""
-      log("finished %s in %s%s (%d of %d); about %s left", name, clock(seconds), what, done, todo, overall_left())
-    elseif state == "failed" then
-      failed_now = failed_now + 1
-      log("FAILED %s after %s: %s (%d of %d); about %s left", name, clock(seconds),
-          failure_message(DIR .. "/" .. name .. ".failed"), done, todo, overall_left())
-    else
-      failed_now = failed_now + 1
-      log("INTERRUPTED %s after %s (stopped by a signal; it starts again on the next run of the study)",
-          name, clock(seconds))
+local function run_all()
+  while #pending > 0 or next(running) do
+    while started_count() < jobs do
+      local run, packs = next_run()
+      if not run then break end
+      start(run, packs)
     end
-    write_tables(gather(runs))
+    sleep(P.poll)
+    -- Between starts and ends of long runs: where the study stands, every `heartbeat` seconds.
+    if P.heartbeat > 0 and asperity.wall_time() - last_heartbeat >= P.heartbeat then
+      last_heartbeat = asperity.wall_time()
+      local now, names = asperity.wall_time(), {}
+      for name, job in pairs(running) do names[#names + 1] = ("%s %s"):format(name, clock(now - job.t)) end
+      table.sort(names)
+      log("%d of %d ended, running: %s; about %s left", done, todo, table.concat(names, ", "), overall_left())
+    end
+    local ended = {}
+    for name, job in pairs(running) do
+      if not alive(job) then ended[#ended + 1] = name end
+    end
+    table.sort(ended)
+    for _, name in ipairs(ended) do
+      local job = running[name]
+      running[name] = nil
+      local seconds = asperity.wall_time() - job.t
+      local state = state_of(name)
+      done = done + 1
+      if state == "finished" then
+        ready[job.run.group] = true
+        local key = job.run.model .. (job.packs and "+pack" or "")
+        for _, k in ipairs{key, job.packs and "any+pack" or "any"} do
+          times[k] = times[k] or {}
+          table.insert(times[k], seconds)
+        end
+        local ok, s = pcall(json.read, DIR .. "/" .. name .. "/summary.json")
+        local what = ok and type(s.peak_shear_stress_mpa) == "number" and type(s.residual_shear_stress_mpa) == "number"
+                     and (": peak %.2f MPa, residual %.2f MPa"):format(s.peak_shear_stress_mpa, s.residual_shear_stress_mpa) or ""
+        log("finished %s in %s%s (%d of %d); about %s left", name, clock(seconds), what, done, todo, overall_left())
+      elseif state == "failed" then
+        failed_now = failed_now + 1
+        log("FAILED %s after %s: %s (%d of %d); about %s left", name, clock(seconds),
+            failure_message(DIR .. "/" .. name .. ".failed"), done, todo, overall_left())
+      else
+        failed_now = failed_now + 1
+        log("INTERRUPTED %s after %s (stopped by a signal; it starts again on the next run of the study)",
+            name, clock(seconds))
+      end
+      write_tables(gather(runs))
+    end
   end
+end
+-- Ctrl-C: the runs stop with the runner (their wrappers see it go) and stay NAME.part.
+local ok, err = pcall(run_all)
+if not ok then
+  if tostring(err):find("interrupted") then
+    local names = {}
+    for name in pairs(running) do names[#names + 1] = name end
+    table.sort(names)
+    log("interrupted: %s left part-way (started again by the same command)",
+        #names > 0 and table.concat(names, ", ") or "no run")
+    write_tables(gather(runs))
+    os.exit(130)
+  end
+  error(err, 0)
 end
 
 local rows = gather(runs)
