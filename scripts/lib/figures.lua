@@ -121,13 +121,17 @@ function M.curves(o)
   local data = os.tmpname()
   local f = assert(io.open(data, "w"))
   local plots, index = {}, 0
+  local xmin, xmax = math.huge, -math.huge
   for k, s in ipairs(o.series) do
     local n = 0
     for i = 1, math.min(#s.x, #s.y) do
       local x, y = s.x[i], s.y[i]
       local ok = x == x and y == y and math.abs(x) < math.huge and math.abs(y) < math.huge and
                  (not o.logx or x > 0) and (not o.logy or y > 0)
-      if ok then f:write(("%.10g %.10g\n"):format(x, y)); n = n + 1 end
+      if ok then
+        f:write(("%.10g %.10g\n"):format(x, y))
+        n, xmin, xmax = n + 1, math.min(xmin, x), math.max(xmax, x)
+      end
     end
     if n > 0 then
       f:write("\n\n")
@@ -142,11 +146,17 @@ function M.curves(o)
   end
   f:close()
   if #plots == 0 then os.remove(data) return false end
+  -- Every point at one x: gnuplot would warn of an empty range; give it one around that x.
+  local xrange = o.xrange
+  if not xrange and xmax == xmin then
+    local pad = xmin ~= 0 and 0.1 * math.abs(xmin) or 1
+    xrange = o.logx and ("%.10g:%.10g"):format(xmin / 2, xmin * 2) or ("%.10g:%.10g"):format(xmin - pad, xmin + pad)
+  end
   gnuplot(("set terminal pngcairo noenhanced size %d,%d\nset output %s\nset xlabel %s\nset ylabel %s\n" ..
            "set title %s\nset grid\nset key %s\n%s%s%s%splot %s\nunset output\n"):format(
     o.width or 900, o.height or 600, quote(o.file), quote(o.xlabel or ""), quote(o.ylabel or ""),
     quote(o.title or ""), o.key or "outside right top", o.logx and "set logscale x\n" or "",
-    o.logy and "set logscale y\n" or "", o.xrange and ("set xrange [%s]\n"):format(o.xrange) or "",
+    o.logy and "set logscale y\n" or "", xrange and ("set xrange [%s]\n"):format(xrange) or "",
     o.extra or "", table.concat(plots, ", ")))
   os.remove(data)
   return true

@@ -300,7 +300,10 @@ local function trends_markdown(T, rows)
   local lines = {"# Expected behaviours (scenarios.md 7) on this study", "",
                  ("%d of %d runs finished. A verdict counts the comparisons of runs that differ in one " ..
                   "factor only (same seed): shown (all agree), partly (most), not shown, or untestable on " ..
-                  "the runs present. Signs, not values; the numbers are means over the comparisons."):format(finished, #rows),
+                  "the runs present. Signs, not values; the numbers are means over the comparisons. A relative " ..
+                  "change goes from the run with the lower value of the factor to the one with the higher (H, Lc, " ..
+                  "s2, normal stress), from x to y, and between models from the one expected lower to the one " ..
+                  "expected higher (e.g. rigid to elastic)."):format(finished, #rows),
                  "", "| behaviour | verdict | agree / comparisons | numbers |", "|---|---|---|---|"}
   for _, t in ipairs(T) do
     local numbers = {}
@@ -322,9 +325,44 @@ local function trends_markdown(T, rows)
     if finite(t.mean_share) then
       numbers[#numbers + 1] = ("mean friction share %.3f (SD %s; thesis ~0.8)"):format(t.mean_share, fmt(t.sd_share))
     end
+    for _, part in ipairs{{"above_rigid", "above rigid"}, {"below_elastic", "below elastic"},
+                          {"rigid_above_elastic", "rigid above elastic"}, {"elastic_above_fracture", "elastic above fracture"}} do
+      local sub = t[part[1]]
+      if sub and sub.comparisons > 0 then
+        numbers[#numbers + 1] = ("%s %d / %d (mean change %+.1f %%)"):format(part[2], sub.agree, sub.comparisons,
+                                                                           100 * (sub.mean_relative_change or 0/0))
+      end
+    end
     if t.verdict == "untestable" and t.reason then numbers[#numbers + 1] = t.reason end
     lines[#lines + 1] = ("| %s | %s | %d / %d | %s |"):format(t.behaviour, t.verdict, t.agree or 0, t.comparisons or 0,
                                                            table.concat(numbers, "; "))
+  end
+  -- The scatter over realisations, where a case ran with several seeds.
+  local cases = M.cases(rows)
+  local rel = {peak_shear_stress_mpa = {}, residual_shear_stress_mpa = {}, max_dilatancy_mm = {}}
+  local multi = 0
+  for _, c in ipairs(cases) do
+    if c.seeds >= 2 then
+      multi = multi + 1
+      for f, list in pairs(rel) do
+        local m, sd = c[f .. "_mean"], c[f .. "_sd"]
+        if finite(m) and finite(sd) and m ~= 0 then list[#list + 1] = sd / math.abs(m) end
+      end
+    end
+  end
+  lines[#lines + 1] = ""
+  lines[#lines + 1] = "## Scatter over surface realisations (seeds)"
+  lines[#lines + 1] = ""
+  if multi == 0 then
+    lines[#lines + 1] = "Every case ran with one seed: no scatter (give seeds=1,2,3)."
+  else
+    lines[#lines + 1] = ("%d cases ran with two or more seeds (study_cases.csv has each case's mean and SD). " ..
+                         "Mean over those cases of SD / mean:"):format(multi)
+    lines[#lines + 1] = ""
+    for _, f in ipairs{"peak_shear_stress_mpa", "residual_shear_stress_mpa", "max_dilatancy_mm"} do
+      local m = mean_sd(rel[f])
+      lines[#lines + 1] = ("- %s: %s"):format(f, finite(m) and ("%.1f %%"):format(100 * m) or "n/a")
+    end
   end
   return table.concat(lines, "\n") .. "\n"
 end
