@@ -162,14 +162,23 @@ if jobs == 0 and threads == 0 then threads = 1 end
 if jobs == 0 then jobs = math.max(1, cores // threads) end
 if threads == 0 then threads = math.max(1, cores // jobs) end
 
+-- The shortest decimal that reads back as the same double.
+local function number_text(v)
+  for digits = 6, 17 do
+    local t = ("%." .. digits .. "g"):format(v)
+    if tonumber(t) == v then return t end
+  end
+  return ("%.17g"):format(v)
+end
+
 -- The command line of one run: the same string here and in the Slurm script.
 local function command(run)
-  local args = {exe, "run", joint_script, "surface=" .. run.surface, ("stress=%g"):format(run.stress),
+  local args = {exe, "run", joint_script, "surface=" .. run.surface, "stress=" .. number_text(run.stress),
                 "direction=" .. run.direction, "model=" .. run.model, "seed=" .. run.seed}
-  if P.size > 0 then args[#args + 1] = ("size=%.17g"):format(P.size) end
+  if P.size > 0 then args[#args + 1] = "size=" .. number_text(P.size) end
   if P.normal_stiffness > 0 then
     args[#args + 1] = "normal_control=stiffness"
-    args[#args + 1] = ("normal_stiffness=%.17g"):format(P.normal_stiffness)
+    args[#args + 1] = "normal_stiffness=" .. number_text(P.normal_stiffness)
   end
   if run.model == "fracture" and P.events_every > 0 then args[#args + 1] = "events_every=" .. P.events_every end
   for _, item in ipairs(extra) do args[#args + 1] = item end

@@ -150,6 +150,11 @@ ok = os.execute(("PATH='%s':\"$PATH\" bash '%s' > '%s/submit.log' 2>&1"):format(
 local calls = read(bin .. "/sbatch.log") or ""
 assert(ok and calls:find("%-%-array=0%-1 .* pack") and calls:find("%-%-array=0%-1 %-%-dependency=afterany:4242 .* run"),
        "submission: " .. calls)
+-- Constant normal stiffness reaches every run's command line.
+status, log = run(("surfaces=S2 stresses=21 directions=y models=elastic normal_stiffness=20 out='%s' slurm='%s'")
+                  :format(out .. "/cns", out .. "/cns.sbatch"), out .. "/cns.log")
+assert(status == 0 and read(out .. "/cns.sbatch"):find(" surface=S2 stress=21 direction=y model=elastic seed=1 " ..
+       "normal_control=stiffness normal_stiffness=20 threads=", 1, true), "CNS command line:\n" .. tostring(read(out .. "/cns.sbatch")))
 -- A task of a finished run exits at once without running it again.
 local before = read(dir .. "/S1_14_x_rigid_s1/summary.json")
 ok = os.execute(("SLURM_ARRAY_TASK_ID=0 bash '%s' pack > '%s/task.log' 2>&1"):format(sb, out))
