@@ -255,7 +255,7 @@ fi
 wait "$child"
 status=$?
 if [ "$status" -eq 0 ] && [ -f "$part/summary.json" ]; then
-  rm -rf "$failed"
+  rm -rf "$failed" "$final"
   mv "$part" "$final"
 elif [ "$status" -gt 128 ]; then
   exit "$status"
