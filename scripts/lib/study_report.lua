@@ -548,13 +548,19 @@ local function events(dir, rows, log)
   local pooled_sizes, pooled_mags, size_series = {}, {}, {}
   local xsum, xweight = {kinetic = {}, strain = {}, damping = {}}, 0
   local pooled_fluct = {kinetic = {}, strain = {}, damping = {}}
-  local sampled = 0
+  local sampled, pooled_breaks, pooled_intervals = 0, 0, 0
   for _, a in ipairs(results) do
     summary[#summary + 1] = ("%s,%d,%d,%d,%.6g,%d,%.6g,%.6g,%.6g,%.6g"):format(a.name, a.breaks, a.intervals, a.interval,
       a.breaks_per_100_steps, #a.sizes, a.b, a.b_error, a.b_energy, a.b_energy_error)
     local lines = {"interval,breaks"}
-    for k, c in ipairs(a.counts) do lines[#lines + 1] = k .. "," .. c end
+    local ks = {}
+    for k, c in ipairs(a.counts) do lines[#lines + 1] = k .. "," .. c; ks[k] = k end
     write_atomic(("%s/%s_breaks.csv"):format(edir, a.name), table.concat(lines, "\n") .. "\n")
+    fig.curves{file = ("%s/%s_breaks.png"):format(edir, a.name), xlabel = ("interval (%d steps) of the shear"):format(a.interval),
+               ylabel = "bonds broken in the interval", series = {{title = "", x = ks, y = a.counts, style = "impulses"}},
+               title = ("%s: %d breaks, %.3g per 100 steps, %d events, b = %.2f +- %.2f"):format(a.name, a.breaks,
+                 a.breaks_per_100_steps, #a.sizes, a.b, a.b_error)}
+    pooled_breaks, pooled_intervals = pooled_breaks + a.breaks, pooled_intervals + a.intervals * a.interval / 100
     local xs, ns = ev.ccdf(a.sizes)
     lines = {"size,events_at_least"}
     for k = 1, #xs do lines[#lines + 1] = xs[k] .. "," .. ns[k] end
@@ -574,6 +580,19 @@ local function events(dir, rows, log)
         lines[#lines + 1] = ("%d,%.6g,%.6g,%.6g"):format(k, a.fluctuations.kinetic[k], a.fluctuations.strain[k], a.fluctuations.damping[k])
       end
       write_atomic(("%s/%s_fluctuations.csv"):format(edir, a.name), table.concat(lines, "\n") .. "\n")
+      local xs_, ds = {}, {}
+      local lags = {}
+      for lag = 0, 20 do lags[lag + 1] = lag end
+      for _, term in ipairs{"kinetic", "strain", "damping"} do
+        local c, d = ev.density(a.fluctuations[term], 40, 8)
+        ds[#ds + 1] = {title = term, x = c, y = d, style = "linespoints"}
+        xs_[#xs_ + 1] = {title = term, x = lags, y = a.xcorr[term], style = "linespoints"}
+      end
+      fig.curves{file = ("%s/%s_xcorr.png"):format(edir, a.name), xlabel = "lag [intervals]",
+                 ylabel = "correlation with the break count", title = a.name .. ": breaks(t) against fluctuation(t + lag)",
+                 series = xs_}
+      fig.curves{file = ("%s/%s_fluctuations.png"):format(edir, a.name), logy = true, xlabel = "fluctuation / its SD",
+                 ylabel = "probability density", title = a.name .. ": energy change per interval", series = ds}
       -- Pooled: each run's fluctuations in units of its own SD; correlations weighted by length.
       local w = #a.counts
       xweight = xweight + w
@@ -588,7 +607,8 @@ local function events(dir, rows, log)
   end
   local pb, pe, pn = ev.aki_b(pooled_sizes, {sizes = true})
   local pbe, pee = ev.aki_b(pooled_mags, {magnitudes = true})
-  summary[#summary + 1] = ("pooled,,,,,%d,%.6g,%.6g,%.6g,%.6g"):format(#pooled_sizes, pb, pe, pbe, pee)
+  summary[#summary + 1] = ("pooled,%d,,,%.6g,%d,%.6g,%.6g,%.6g,%.6g"):format(pooled_breaks,
+    pooled_intervals > 0 and pooled_breaks / pooled_intervals or 0/0, #pooled_sizes, pb, pe, pbe, pee)
   write_atomic(edir .. "/summary.csv", table.concat(summary, "\n") .. "\n")
   local xs, ns = ev.ccdf(pooled_sizes)
   size_series[#size_series + 1] = {title = ("pooled: b = %.2f +- %.2f (%d events)"):format(pb, pe, pn), x = xs, y = ns,
@@ -597,6 +617,8 @@ local function events(dir, rows, log)
              ylabel = "events with size >= S", title = "break events (M = log10 S): each fracture run (thin), pooled (black)",
              series = size_series, key = "top right"}
   local out = {runs = #results, sampled_runs = sampled, pooled_events = #pooled_sizes, pooled_b = pb, pooled_b_error = pe,
+               pooled_breaks = pooled_breaks,
+               pooled_breaks_per_100_steps = pooled_intervals > 0 and pooled_breaks / pooled_intervals or 0/0,
                pooled_b_energy = pbe, pooled_b_energy_error = pee,
                magnitude = "M = log10 S, S the bonds broken in one event (consecutive intervals with breaks); " ..
                            "b by maximum likelihood (lib/events.lua); b_energy on M_E = log10(E / 1 J)",
