@@ -104,6 +104,9 @@ if P.normal_control == "stiffness" and not (P.normal_stiffness > 0 and P.normal_
 elseif P.normal_control ~= "stiffness" and P.normal_stiffness ~= 0 then
   error(("normal_stiffness=%s needs normal_control=stiffness (now '%s')"):format(tostring(P.normal_stiffness), P.normal_control), 0)
 end
+if math.type(P.events_every) ~= "integer" or P.events_every < 0 then
+  error(("events_every must be a whole number of steps >= 0 (0: no samples), got %s"):format(tostring(P.events_every)), 0)
+end
 local t_start = asperity.wall_time()
 asperity.mkdir(P.out)
 asperity.mkdir(P.cache)
@@ -586,7 +589,8 @@ record_shear()
 local record_every = math.max(1, math.floor(P.record * 1e-3 / (P.velocity * world:dt()) + 0.5))
 -- Event statistics (scenarios.md 8): the energies every `events_every` steps while shearing; the
 -- breaks themselves come from world:break_events. The run then calls back every step, so the records
--- and the velocity ramp keep their steps and the run its results.
+-- and the velocity ramp keep their steps (reading the energies still moves a chaotic run in its last
+-- digits: scripts/README.md).
 local events, sample_every, breaks_before = nil, record_every, world:break_count()
 if P.events_every > 0 then
   sample_every = 1
