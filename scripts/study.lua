@@ -17,8 +17,8 @@
 --
 -- Writes DIR/study.csv and DIR/study.json (one row per run), rewritten (to a temporary name, then
 -- renamed) whenever a run ends; then the report (scripts/lib/study_report.lua): trends.json,
--- trends.md, plots/*.png, and events/ (scenarios.md 8). Exit status: the number of failed runs
--- (at most 100).
+-- trends.md, plots/*.png, and events/ (scenarios.md 8). Exit status: the number of asked runs not
+-- finished (failed or interrupted; at most 100).
 local json = require("json")
 
 local P = require("params").defaults{
@@ -217,19 +217,20 @@ end
 local RUN_SH = [=[#!/bin/sh
 # One run of a study, written by scripts/study.lua (the runner and its Slurm script both call it):
 #
-#   run.sh NAME WATCH_PID 'COMMAND'
+#   run.sh NAME WATCH_PID RETRY 'COMMAND'
 #
 # Runs COMMAND (an `asperity run .../joint.lua ... out=STUDY/NAME.part` line) with its output in
 # STUDY/NAME.part/log.txt. On success (exit 0 and a summary.json) the folder is renamed to
 # STUDY/NAME, so a folder STUDY/NAME is always a finished run and a finished run is skipped; on
-# failure to STUDY/NAME.failed, with exit_status. A run ended by a signal (kill, Ctrl-C: status
-# above 128) stays STUDY/NAME.part and starts again next time. WATCH_PID > 0: a process (the
-# runner) whose end stops the run too.
+# failure to STUDY/NAME.failed, with exit_status, which is skipped too unless RETRY is 1. A run
+# ended by a signal (kill, Ctrl-C: status above 128) stays STUDY/NAME.part and starts again next
+# time. WATCH_PID > 0: a process (the runner) whose end stops the run too.
 set -u
 study=$(cd "$(dirname "$0")/.." && pwd)
 name=$1
 watch=$2
-cmd=$3
+retry=$3
+cmd=$4
 final="$study/$name"
 part="$final.part"
 failed="$final.failed"
@@ -237,6 +238,7 @@ mkdir -p "$study/.study/locks"
 exec 9>"$study/.study/locks/$name"
 flock -w 600 9 || { echo "run.sh: $name is locked by another process" >&2; exit 75; }
 [ -f "$final/summary.json" ] && exit 0
+[ "$retry" = 1 ] || [ ! -f "$failed/exit_status" ] || exit 0
 rm -rf "$part"
 mkdir -p "$part"
 printf '%s\n' "$cmd" > "$part/command.txt"
@@ -466,12 +468,13 @@ if P.slurm ~= "" then
 # A Slurm job array for a study of asperity (written by scripts/study.lua; see scripts/README.md).
 #
 #   bash %s              submits: the packing array, then the run array after it
-#   %s runs: %d packing (one per surface and seed), %d after them; threads per run: %d
+#   study %s: %d packing runs (one per surface and seed), then %d; %d threads per run
 #
 # Every task runs one joint.lua command through %s/.study/run.sh, the wrapper the runner uses:
 # finished runs are skipped, a run killed part-way starts again when its task runs again, a failed
-# run is kept in NAME.failed. Resubmit the same file to resume; gather the results on any machine
-# with: asperity run scripts/study.lua collect=true out=%s
+# run is kept in NAME.failed (and run again only if the script was written with retry=true).
+# Resubmit the same file to resume; gather the results on any machine with:
+#   asperity run scripts/study.lua collect=true out=%s
 #SBATCH --job-name=asperity-study
 #SBATCH --ntasks=1
 #SBATCH --cpus-per-task=%d
@@ -501,9 +504,9 @@ run)
   esac ;;
 *) echo "usage: bash $0 (submits), or as an array task with the argument pack or run" >&2; exit 2 ;;
 esac
-exec sh "$study/.study/run.sh" "$name" 0 "$cmd"
+exec sh "$study/.study/run.sh" "$name" 0 %d "$cmd"
 ]=]):format(P.slurm, DIR, #packers, #others, threads, DIR, DIR, threads, DIR, shell_quote(DIR),
-             #packers - 1, #others, cases(packers), cases(others))
+             #packers - 1, #others, cases(packers), cases(others), P.retry and 1 or 0)
   write_atomic(P.slurm, text)
   log("wrote %s: %d runs (%d packing, then %d), %d threads each; submit with: bash %s",
       P.slurm, #runs, #packers, #others, threads, P.slurm)
@@ -586,8 +589,8 @@ local function overall_left()
 end
 
 local function start(run, packs)
-  local line = ("sh %s %s %d %s >/dev/null 2>&1 & echo $!"):format(shell_quote(DIR .. "/.study/run.sh"),
-    shell_quote(run.name), my_pid, shell_quote(command(run)))
+  local line = ("sh %s %s %d %d %s >/dev/null 2>&1 & echo $!"):format(shell_quote(DIR .. "/.study/run.sh"),
+    shell_quote(run.name), my_pid, P.retry and 1 or 0, shell_quote(command(run)))
   local pid = tonumber(capture(line))
   if not pid then fail("could not start the run %s", run.name) end
   running[run.name] = {run = run, pid = pid, t = asperity.wall_time(), packs = packs}

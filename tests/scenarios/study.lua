@@ -115,6 +115,9 @@ assert(log:find("FAILED S1_14_y_rigid_s1", 1, true), "the failure is reported:\n
 -- Failed runs are kept (not rerun) unless retry=true.
 status, log = run(("surfaces=S1 stresses=14 directions=x,y models=rigid out='%s' joint='overlap_limit=-1'"):format(bad), out .. "/bad2.log")
 assert(status == 2 and log:find("2 failed before", 1, true) and not log:find("started", 1, true), "failed runs kept:\n" .. log)
+status, log = run(("surfaces=S1 stresses=14 directions=x,y models=rigid retry=true out='%s' joint='overlap_limit=-1'"):format(bad),
+                  out .. "/bad3.log")
+assert(status == 2 and select(2, log:gsub("started S1_14_", "")) == 2, "retry=true runs them again:\n" .. log)
 
 -- 3. The Slurm script of the first study.
 local sb = out .. "/study.sbatch"
