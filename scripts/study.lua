@@ -244,9 +244,18 @@ mkdir -p "$part"
 printf '%s\n' "$cmd" > "$part/command.txt"
 sh -c "exec $cmd" > "$part/log.txt" 2>&1 9>&- &
 child=$!
+# A process that has ended but not been reaped yet (a zombie) still answers kill -0: read its state.
+alive() {
+  if [ -r "/proc/$1/stat" ]; then
+    state=$(sed 's/^.*) //' "/proc/$1/stat" 2>/dev/null | cut -c1)
+    [ -n "$state" ] && [ "$state" != Z ]
+  else
+    kill -0 "$1" 2>/dev/null
+  fi
+}
 if [ "$watch" -gt 0 ]; then
   while kill -0 "$child" 2>/dev/null; do
-    if ! kill -0 "$watch" 2>/dev/null; then
+    if ! alive "$watch"; then
       kill "$child" 2>/dev/null
       wait "$child"
       exit 143
