@@ -593,8 +593,8 @@ local function overall_left()
     local e = estimate(job.run, job.packs)
     if e then total = total + math.max(0, e - (now - job.t)) else known = false end
   end
-  if not known then return "an unknown time" end
-  return clock(total / jobs)
+  if not known then return "time left not known yet" end
+  return "about " .. clock(total / jobs) .. " left"
 end
 
 local function start(run, packs)
@@ -649,7 +649,7 @@ local function run_all()
       local now, names = asperity.wall_time(), {}
       for name, job in pairs(running) do names[#names + 1] = ("%s %s"):format(name, clock(now - job.t)) end
       table.sort(names)
-      log("%d of %d ended, running: %s; about %s left", done, todo, table.concat(names, ", "), overall_left())
+      log("%d of %d ended, running: %s; %s", done, todo, table.concat(names, ", "), overall_left())
     end
     local ended = {}
     for name, job in pairs(running) do
@@ -672,10 +672,10 @@ local function run_all()
         local ok, s = pcall(json.read, DIR .. "/" .. name .. "/summary.json")
         local what = ok and type(s.peak_shear_stress_mpa) == "number" and type(s.residual_shear_stress_mpa) == "number"
                      and (": peak %.2f MPa, residual %.2f MPa"):format(s.peak_shear_stress_mpa, s.residual_shear_stress_mpa) or ""
-        log("finished %s in %s%s (%d of %d); about %s left", name, clock(seconds), what, done, todo, overall_left())
+        log("finished %s in %s%s (%d of %d); %s", name, clock(seconds), what, done, todo, overall_left())
       elseif state == "failed" then
         failed_now = failed_now + 1
-        log("FAILED %s after %s: %s (%d of %d); about %s left", name, clock(seconds),
+        log("FAILED %s after %s: %s (%d of %d); %s", name, clock(seconds),
             failure_message(DIR .. "/" .. name .. ".failed"), done, todo, overall_left())
       else
         failed_now = failed_now + 1
