@@ -134,11 +134,13 @@ function M.cross_correlation(a, b, max_lag)
   return r
 end
 
--- One run's folder -> its statistics (nil if it has no breaks.csv).
+-- One run's folder -> its statistics (nil if it has neither file: nothing broke and nothing was
+-- sampled; a run sampled without a break counts its intervals, all empty).
 function M.analyse_run(folder)
   local breaks = M.read_csv(folder .. "/breaks.csv")
   local ev = M.read_csv(folder .. "/events.csv")
-  if not breaks then return nil end
+  if not breaks and not ev then return nil end
+  breaks = breaks or {step = {}, released_energy = {}}
   local r = {folder = folder}
   local steps, energies = breaks.step, breaks.released_energy
   -- The intervals and the break count of each.

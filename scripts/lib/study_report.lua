@@ -541,7 +541,8 @@ local function events(dir, rows, log)
     end
   end
   if #results == 0 then
-    return {runs = 0, note = #missing > 0 and "no breaks.csv in the fracture runs (no bond broke)" or "no finished fracture run"}
+    return {runs = 0, note = #missing > 0 and "fracture runs without breaks.csv or events.csv (no bond broke, no samples)"
+                                          or "no finished fracture run"}
   end
   asperity.mkdir(edir)
   local summary = {"run,breaks,intervals,interval_steps,breaks_per_100_steps,events,b,b_error,b_energy,b_energy_error"}

@@ -51,4 +51,15 @@ assert(#r.sizes == 2 and r.sizes[1] == 3 and r.sizes[2] == 3, "events: intervals
 assert(math.abs(r.event_energy[1] - 1.5) < 1e-12, "an event's energy is the sum of its breaks'")
 assert(math.abs(r.xcorr.kinetic[1] - 1) < 1e-12, "lag 0: the kinetic fluctuation equals the count")
 assert(r.xcorr.strain[1] ~= r.xcorr.strain[1], "a constant term has no correlation (NaN)")
+-- A run sampled without a single break: its intervals count, all empty; no event, no b.
+local quiet = out .. "/quiet"
+asperity.mkdir(quiet)
+f = assert(io.open(quiet .. "/events.csv", "w"))
+f:write("step [1],displacement [mm],broken_bonds [1],kinetic [J],strain [J],damping [J],friction [J],released [J]\n")
+for k = 1, 5 do f:write(("%d,0,0,%g,1,%g,0,0\n"):format(100 * k, k, k)) end
+f:close()
+local q = ev.analyse_run(quiet)
+assert(q and q.breaks == 0 and q.intervals == 4 and q.breaks_per_100_steps == 0 and #q.sizes == 0 and q.b ~= q.b,
+       "a run without breaks")
+assert(ev.analyse_run(out .. "/nothing_here") == nil, "a folder with neither file")
 print("PASS")
