@@ -12,7 +12,7 @@
 -- (DIR/NAME.failed with the exit status if it failed). So a folder DIR/NAME is always a finished
 -- run, and rerunning the same command skips it: a run that was killed is left as NAME.part and
 -- starts again. The runs of one surface and seed share one packed specimen (joint.lua's cache):
--- the first of them packs it, and the others start only when it has finished, so a specimen is
+-- the first of them packs it, and the others start only once it is cached, so a specimen is
 -- packed once however many jobs run at once.
 --
 -- Writes DIR/study.csv and DIR/study.json (one row per run), rewritten (to a temporary name, then
@@ -650,6 +650,18 @@ local function run_all()
       for name, job in pairs(running) do names[#names + 1] = ("%s %s"):format(name, clock(now - job.t)) end
       table.sort(names)
       log("%d of %d ended, running: %s; %s", done, todo, table.concat(names, ", "), overall_left())
+    end
+    -- A packer's specimen is cached once joint.lua analyses its DEM surfaces: the other runs of
+    -- its group may start then instead of waiting for its shear (if that line ever changes, they
+    -- wait for the packer to end, as they would anyway).
+    for name, job in pairs(running) do
+      if job.packs and not ready[job.run.group] then
+        local text = read_text(DIR .. "/" .. name .. ".part/log.txt")
+        if text and text:find("[joint] DEM surface:", 1, true) then
+          ready[job.run.group] = true
+          log("specimen of %s ready (packed by %s)", job.run.group, name)
+        end
+      end
     end
     local ended = {}
     for name, job in pairs(running) do
