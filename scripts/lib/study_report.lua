@@ -475,15 +475,18 @@ local function plots(dir, rows, curves, log)
                                  color = COLOR[m], size = 1.5}
         end
       end
-      if stress == M.REFERENCE_STRESS then
-        for _, which in ipairs{{"peak", 5}, {"residual", 4}} do
-          local xs, ys = {}, {}
-          for s, ref in pairs(M.REFERENCE) do
-            for _, m in ipairs(MODELS) do xs[#xs + 1] = SURFACE[s][axis]; ys[#ys + 1] = ref[which[1]][m] end
-          end
-          series[#series + 1] = {title = "thesis " .. which[1] .. " (all models)", x = xs, y = ys, style = "points",
-                                 point = which[2], color = "#000000", size = 1.2}
+      -- At another stress the thesis's values as ratios to the normal stress (reference.md 2: these
+      -- transfer better than the MPa), in grey.
+      local scale = stress / M.REFERENCE_STRESS
+      for _, which in ipairs{{"peak", 5}, {"residual", 4}} do
+        local xs, ys = {}, {}
+        for s, ref in pairs(M.REFERENCE) do
+          for _, m in ipairs(MODELS) do xs[#xs + 1] = SURFACE[s][axis]; ys[#ys + 1] = ref[which[1]][m] * scale end
         end
+        series[#series + 1] = {title = ("thesis %s (all models)%s"):format(which[1],
+                                 scale == 1 and "" or (", x %g/%g"):format(stress, M.REFERENCE_STRESS)),
+                               x = xs, y = ys, style = "points", point = which[2],
+                               color = scale == 1 and "#000000" or "#808080", size = 1.2}
       end
       draw{file = ("%s/strength_vs_%s_%g.png"):format(pdir, p[1], stress), xlabel = p[2], ylabel = "shear stress [MPa]",
            title = ("peak (filled) and residual (open) at %g MPa"):format(stress), series = series,
