@@ -550,7 +550,7 @@ local function events(dir, rows, log)
   asperity.mkdir(edir)
   local summary = {"run,breaks,intervals,interval_steps,breaks_per_100_steps,events,b,b_error,b_energy,b_energy_error"}
   local pooled_sizes, pooled_mags, size_series = {}, {}, {}
-  local xsum, xweight = {kinetic = {}, strain = {}, damping = {}}, 0
+  local xsum, xweight = {kinetic = {}, strain = {}, damping = {}}, {kinetic = {}, strain = {}, damping = {}}
   local pooled_fluct = {kinetic = {}, strain = {}, damping = {}}
   local sampled, pooled_breaks, pooled_intervals = 0, 0, 0
   for _, a in ipairs(results) do
@@ -599,10 +599,12 @@ local function events(dir, rows, log)
                  ylabel = "probability density", title = a.name .. ": energy change per interval", series = ds}
       -- Pooled: each run's fluctuations in units of its own SD; correlations weighted by length.
       local w = #a.counts
-      xweight = xweight + w
       for term, r in pairs(a.xcorr) do
         for lag = 1, 21 do
-          if finite(r[lag]) then xsum[term][lag] = (xsum[term][lag] or 0) + w * r[lag] end
+          if finite(r[lag]) then
+            xsum[term][lag] = (xsum[term][lag] or 0) + w * r[lag]
+            xweight[term][lag] = (xweight[term][lag] or 0) + w
+          end
         end
         local m, sd = mean_sd(a.fluctuations[term])
         if sd > 0 then for _, v in ipairs(a.fluctuations[term]) do table.insert(pooled_fluct[term], (v - m) / sd) end end
@@ -637,7 +639,7 @@ local function events(dir, rows, log)
     local series = {}
     for _, term in ipairs{"kinetic", "strain", "damping"} do
       local lx, ly = {}, {}
-      for lag = 0, 20 do lx[#lx + 1] = lag; ly[#ly + 1] = (xsum[term][lag + 1] or 0/0) / xweight end
+      for lag = 0, 20 do lx[#lx + 1] = lag; ly[#ly + 1] = (xsum[term][lag + 1] or 0/0) / (xweight[term][lag + 1] or 0/0) end
       series[#series + 1] = {title = term, x = lx, y = ly, style = "linespoints"}
     end
     for lag = 0, 20 do
