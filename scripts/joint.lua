@@ -44,7 +44,9 @@ local P = require("params").defaults{
   quasi_static_limit = 0.01, -- warn when the kinetic energy exceeds this x normal load x mean radius
   overlap_limit = 0.5,     -- warn when a contact overlaps this fraction of the smaller radius (the engine
                            -- stops at 1): the contacts are too soft for the load (perf/README.md)
-  normal_control = "servo", -- servo (model.md 7, with integral action) or load: a constant force on a free platen
+  normal_control = "servo", -- servo (model.md 7, with integral action), load: a constant force on a free platen,
+                           -- or stiffness: constant normal stiffness, sigma_0 + normal_stiffness x dilatancy
+  normal_stiffness = 0,    -- MPa/mm (scaled) of normal_control=stiffness
   platen_damping = 0,      -- local damping of the dead-load platen (< 0: the world's)
   servo_relaxation = 0.4,  -- servo gain: fraction of the force error the platen contacts correct per step
   servo_integral_steps = 2, -- integral time of the servo, in time steps (0: proportional only, model.md 7)
@@ -75,6 +77,7 @@ local P = require("params").defaults{
   simd = "auto",           -- kernels of closure and shear: auto, an architecture, or "float" (the force laws
                            -- in single precision, scalar: perf/runtime_vs_error.lua's study); packing: auto
   progress = true,
+  events_every = 0,        -- steps between energy samples for the event statistics (events.{h5,csv}); 0: none
   save = "",               -- a path: the world's checkpoint when the shear ends (to continue from it,
                            -- or to time the shear step in one process: perf/README.md, perf/ab.sh)
   stop_after = "",         -- "packing": stop once the halves are packed, before bonding (the world
@@ -93,6 +96,15 @@ if P.stop_after ~= "" and P.stop_after ~= "packing" then
 end
 for _, key in ipairs{"quasi_static_limit", "overlap_limit"} do
   if not (P[key] > 0) then error(("%s must be > 0, got %s"):format(key, tostring(P[key]))) end
+end
+-- Constant normal stiffness: a stiffness is what makes it one (0 would be the servo's CNL).
+if P.normal_control == "stiffness" and not (P.normal_stiffness > 0 and P.normal_stiffness < math.huge) then
+  error(("normal_stiffness must be > 0 MPa/mm with normal_control=stiffness, got %s"):format(tostring(P.normal_stiffness)), 0)
+elseif P.normal_control ~= "stiffness" and P.normal_stiffness ~= 0 then
+  error(("normal_stiffness=%s needs normal_control=stiffness (now '%s')"):format(tostring(P.normal_stiffness), P.normal_control), 0)
+end
+if math.type(P.events_every) ~= "integer" or P.events_every < 0 then
+  error(("events_every must be a whole number of steps >= 0 (0: no samples), got %s"):format(tostring(P.events_every)), 0)
 end
 local t_start = asperity.wall_time()
 asperity.mkdir(P.out)
@@ -494,9 +506,15 @@ shear_velocity[axis] = -P.velocity
 -- noise): it follows any dilatancy at once and the load it transmits differs from the target only
 -- by its inertia. "servo" (model.md 7): the platen's z velocity follows the force error, with
 -- integral action (servo_integral_steps) so that a steady dilatancy rate leaves no lag.
-local modes = {"fixed", "fixed", P.normal_control == "servo" and "servo" or "free"}
+-- "stiffness": the same servo, its target rising by normal_stiffness x the platen's rise (constant
+-- normal stiffness, the engine's servo `stiffness`); it settles on sigma_0 like the CNL servo, and
+-- the stiffness is switched on when the shear starts, so the dilatancy it acts on is the recorded one.
+local servo_control = P.normal_control == "servo" or P.normal_control == "stiffness"
+local modes = {"fixed", "fixed", servo_control and "servo" or "free"}
 modes[axis] = "velocity"
-if P.normal_control == "servo" then
+-- MPa/mm scaled -> N/m of the platen: model Pa per m of rise, times the area.
+local cns_stiffness = P.normal_control == "stiffness" and P.normal_stiffness * 1e6 / stress_scale * 1e3 * area or 0
+if servo_control then
   world:set_group_motion(top, {translation = modes, velocity = shear_velocity,
                                servo = {target_force = target_stress * area, max_velocity = P.servo_max_velocity * P.velocity,
                                         relaxation = P.servo_relaxation,
@@ -506,7 +524,7 @@ elseif P.normal_control == "load" then
   applied_z = -target_stress * area
   world:set_group_force(top, {0, 0, applied_z})
 else
-  error("normal_control must be load or servo, got '" .. P.normal_control .. "'")
+  error("normal_control must be servo, load or stiffness, got '" .. P.normal_control .. "'")
 end
 -- Let the platen settle on the target load before shearing.
 do
@@ -578,6 +596,21 @@ local function record_shear()
 end
 record_shear()
 local record_every = math.max(1, math.floor(P.record * 1e-3 / (P.velocity * world:dt()) + 0.5))
+-- Event statistics (scenarios.md 8): the energies every `events_every` steps while shearing; the
+-- breaks themselves come from world:break_events. The run then calls back every step, so the records
+-- and the velocity ramp keep their steps (reading the energies still moves a chaotic run in its last
+-- digits: scripts/README.md).
+local events, sample_every, breaks_before = nil, record_every, world:break_count()
+if P.events_every > 0 then
+  sample_every = 1
+  events = asperity.series{"step [1]", "displacement [mm]", "broken_bonds [1]", "kinetic [J]", "strain [J]",
+                           "damping [J]", "friction [J]", "released [J]"}
+end
+local function record_events()
+  local en = world:energies()
+  events:record(world:step(), displacement(), world:break_count() - breaks_before, en.kinetic, en.strain,
+                en.damping, en.friction, en.released)
+end
 local shear_t0, shear_s0, shear_r0 = asperity.wall_time(), world:step(), world:stats().rebuilds
 -- The shear velocity rises linearly over `ramp` mm (time 2 ramp / v), in one stage per record.
 local ramp_stages = P.ramp > 0 and math.max(1, math.ceil(2 * P.ramp * 1e-3 / P.velocity / world:dt() / record_every)) or 1
@@ -586,10 +619,17 @@ local function set_shear_velocity(stage)
   v[axis] = -P.velocity * math.min(1, stage / ramp_stages)
   world:set_group_motion(top, {translation = modes, velocity = v})
 end
+if cns_stiffness > 0 then world:set_group_motion(top, {servo = {stiffness = cns_stiffness}}) end
 set_shear_velocity(1)
 local stage = 1
-world:run{steps = 100000000, every = record_every, progress = P.progress,
+if events then record_events() end
+world:run{steps = 100000000, every = sample_every, progress = P.progress,
           callback = function()
+            if events then
+              local k = world:step() - shear_s0
+              if k % P.events_every == 0 then record_events() end
+              if k % record_every ~= 0 then return end
+            end
             record_shear()
             if stage < ramp_stages then stage = stage + 1; set_shear_velocity(stage) end
           end,
@@ -612,6 +652,19 @@ end
 local shear_seconds, shear_steps = asperity.wall_time() - shear_t0, world:step() - shear_s0
 local shear_rebuilds = world:stats().rebuilds - shear_r0
 shear:write(P.out .. "/shear")
+if events then events:write(P.out .. "/events") end
+-- Every bond break while shearing (model.md 5), for the event statistics and maps.
+if world:break_count() > breaks_before then
+  local breaks = asperity.series{"step [1]", "time [s]", "x [m]", "y [m]", "z [m]", "mode [1]", "sigma [Pa]",
+                                 "tau [Pa]", "released_energy [J]"}
+  breaks:set_attribute("mode", "1 tension, 2 compression, 3 shear")
+  local mode_code = {tension = 1, compression = 2, shear = 3}
+  for _, ev in ipairs(world:break_events(breaks_before + 1)) do
+    breaks:record(ev.step, ev.time, ev.position[1], ev.position[2], ev.position[3], mode_code[ev.mode] or 0,
+                  ev.sigma, ev.tau, ev.released_energy)
+  end
+  breaks:write(P.out .. "/breaks")
+end
 log("sheared %.2f mm", displacement())
 
 -- 8. Summary --------------------------------------------------------------------------------
@@ -665,10 +718,13 @@ end
 local q = fit(lx, ly)
 local sn_mean = shear:column("normal_stress_mean_mpa")
 local sn_dev, sn_dev_mean, devs = 0, 0, {}
+-- The stress the control asks for: sigma_0, or with constant normal stiffness sigma_0 + K dilatancy
+-- (for an interval mean, at the interval's mean dilatancy).
+local K_cns = P.normal_control == "stiffness" and P.normal_stiffness or 0
 for k = 1, rows do
   if u[k] > 0.05 then
-    sn_dev = math.max(sn_dev, math.abs(sn[k] / P.stress - 1))
-    devs[#devs + 1] = math.abs(sn_mean[k] / P.stress - 1)
+    sn_dev = math.max(sn_dev, math.abs(sn[k] / (P.stress + K_cns * dil[k]) - 1))
+    devs[#devs + 1] = math.abs(sn_mean[k] / (P.stress + K_cns * 0.5 * (dil[k] + dil[math.max(1, k - 1)])) - 1)
     sn_dev_mean = math.max(sn_dev_mean, devs[#devs])
   end
 end

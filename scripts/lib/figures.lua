@@ -5,6 +5,9 @@
 --   fig.histogram{file = "h.png", values = {...}, bins = 40, xlabel = "sigma [Pa]", csv = "h.csv"}
 --   fig.map{file = "m.png", points = {{x, y, z, group}, ...}, groups = {"tension", "shear"},
 --           extent = {min = {..}, max = {..}}, title = "..."}
+--   fig.curves{file = "c.png", xlabel = "u [mm]", ylabel = "tau [MPa]", logx = false, logy = false,
+--              series = {{title = "S1", x = {...}, y = {...}, style = "lines", color = "#d02020",
+--                         dash = 2, point = 7}, ...}}
 local M = {}
 
 local function gnuplot(script)
@@ -108,6 +111,55 @@ function M.map(o)
   lines[#lines + 1] = "unset multiplot\nunset output\n"
   gnuplot(table.concat(lines))
   os.remove(data)
+end
+
+-- Several x-y series in one figure: lines, points or both (style "lines", "points",
+-- "linespoints"); a series with no finite point is left out (a figure with none is not drawn).
+-- Returns true if the figure was drawn.
+function M.curves(o)
+  local palette = {"#d02020", "#2050d0", "#20a040", "#e08000", "#8040c0", "#00a0a0", "#a0a000", "#606060"}
+  local data = os.tmpname()
+  local f = assert(io.open(data, "w"))
+  local plots, index = {}, 0
+  local xmin, xmax = math.huge, -math.huge
+  for k, s in ipairs(o.series) do
+    local n = 0
+    for i = 1, math.min(#s.x, #s.y) do
+      local x, y = s.x[i], s.y[i]
+      local ok = x == x and y == y and math.abs(x) < math.huge and math.abs(y) < math.huge and
+                 (not o.logx or x > 0) and (not o.logy or y > 0)
+      if ok then
+        f:write(("%.10g %.10g\n"):format(x, y))
+        n, xmin, xmax = n + 1, math.min(xmin, x), math.max(xmax, x)
+      end
+    end
+    if n > 0 then
+      f:write("\n\n")
+      local style = s.style or "lines"
+      local spec = ("%s index %d using 1:2 with %s lw %g lc rgb %s"):format(quote(data), index, style,
+        s.width or 2, quote(s.color or palette[(k - 1) % #palette + 1]))
+      if s.dash then spec = spec .. " dt " .. s.dash end
+      if style ~= "lines" then spec = spec .. (" pt %d ps %g"):format(s.point or 7, s.size or 1) end
+      plots[#plots + 1] = spec .. " title " .. quote(s.title or "")
+      index = index + 1
+    end
+  end
+  f:close()
+  if #plots == 0 then os.remove(data) return false end
+  -- Every point at one x: gnuplot would warn of an empty range; give it one around that x.
+  local xrange = o.xrange
+  if not xrange and xmax == xmin then
+    local pad = xmin ~= 0 and 0.1 * math.abs(xmin) or 1
+    xrange = o.logx and ("%.10g:%.10g"):format(xmin / 2, xmin * 2) or ("%.10g:%.10g"):format(xmin - pad, xmin + pad)
+  end
+  gnuplot(("set terminal pngcairo noenhanced size %d,%d\nset output %s\nset xlabel %s\nset ylabel %s\n" ..
+           "set title %s\nset grid\nset key %s\n%s%s%s%splot %s\nunset output\n"):format(
+    o.width or 900, o.height or 600, quote(o.file), quote(o.xlabel or ""), quote(o.ylabel or ""),
+    quote(o.title or ""), o.key or "outside right top", o.logx and "set logscale x\n" or "",
+    o.logy and "set logscale y\n" or "", xrange and ("set xrange [%s]\n"):format(xrange) or "",
+    o.extra or "", table.concat(plots, ", ")))
+  os.remove(data)
+  return true
 end
 
 return M

@@ -1,0 +1,731 @@
+-- The study (scenarios.md 7, 8): closure + shear runs of joint.lua over surfaces x normal stresses x
+-- directions x models x surface realisations, side by side, resumable, gathered into one table, a
+-- trend report, comparison plots and the event statistics of the fracture runs.
+--
+--   build/asperity run scripts/study.lua                                   -- all 96 runs, out/study/
+--   build/asperity run scripts/study.lua surfaces=S1,S4,S5 directions=x jobs=2 threads=1 out=out/s
+--   build/asperity run scripts/study.lua collect=true out=out/s            -- tables and report again
+--   build/asperity run scripts/study.lua slurm=study.sbatch out=/scratch/s -- a Slurm job array
+--
+-- Every run is a child process `asperity run scripts/joint.lua ... out=DIR/NAME.part` started by
+-- DIR/.study/run.sh, which renames the folder to DIR/NAME once the run has written its summary
+-- (DIR/NAME.failed with the exit status if it failed). So a folder DIR/NAME is always a finished
+-- run, and rerunning the same command skips it: a run that was killed is left as NAME.part and
+-- starts again. The runs of one surface and seed share one packed specimen (joint.lua's cache):
+-- the first of them packs it, and the others start only once it is cached, so a specimen is
+-- packed once however many jobs run at once.
+--
+-- Writes DIR/study.csv and DIR/study.json (one row per run), rewritten (to a temporary name, then
+-- renamed) whenever a run ends; then the report (scripts/lib/study_report.lua): trends.json,
+-- trends.md, plots/*.png, and events/ (scenarios.md 8). Exit status: the number of asked runs not
+-- finished (failed or interrupted; at most 100).
+local json = require("json")
+
+local P = require("params").defaults{
+  surfaces = "S1,S2,S3,S4,S5,S6,S7,S8",
+  stresses = "14,21",         -- normal stresses, MPa (scaled)
+  directions = "x,y",
+  models = "rigid,elastic,fracture",
+  seeds = "1",                -- surface realisations (one phase field per seed, shared by S1..S8)
+  size = 0,                   -- side of the joints, m (0: joint.lua's default)
+  normal_stiffness = 0,       -- MPa/mm: constant normal stiffness (0: constant normal load)
+  events_every = 100,         -- steps between the energy samples of the fracture runs (event statistics; 0: none)
+  joint = "",                 -- more key=value parameters for every joint.lua run, space-separated
+  out = "out/study",
+  jobs = 0,                   -- runs at once (0: the machine's cores / threads)
+  threads = 0,                -- threads of each run (0: the cores / jobs, at least 1)
+  retry = false,              -- true: runs that failed before are run again
+  collect = false,            -- true: only rebuild the tables and the report from DIR's folders
+  slurm = "",                 -- a file: write a Slurm job-array script for the runs instead of running
+  report = true,              -- false: tables only (no trends, plots, event statistics)
+  asperity = "",              -- the program each run uses (default: the one running this script)
+  poll = 0.5,                 -- s between looks at the running jobs
+  heartbeat = 600,            -- s between progress lines while runs go on (0: only at starts and ends)
+}
+
+local function log(fmt, ...) io.stderr:write(("[study] " .. fmt .. "\n"):format(...)) end
+local function fail(fmt, ...) error((fmt):format(...), 0) end
+
+-- Parameters -----------------------------------------------------------------------------------
+local function list(name, allowed_text, check)
+  local items, seen = {}, {}
+  for item in tostring(P[name]):gmatch("[^,%s]+") do
+    local v = check(item)
+    if v == nil then fail("%s: '%s' is not allowed (allowed: %s)", name, item, allowed_text) end
+    if seen[tostring(v)] then fail("%s: '%s' is listed twice", name, item) end
+    seen[tostring(v)] = true
+    items[#items + 1] = v
+  end
+  if #items == 0 then fail("%s is empty (give a comma-separated list of %s)", name, allowed_text) end
+  return items
+end
+local surfaces = list("surfaces", "S1..S8", function(s) return s:match("^S[1-8]$") and s or nil end)
+local stresses = list("stresses", "positive numbers, MPa", function(s)
+  local v = tonumber(s)
+  return v and v > 0 and v < math.huge and v or nil
+end)
+local directions = list("directions", "x, y", function(s) return (s == "x" or s == "y") and s or nil end)
+local models = list("models", "rigid, elastic, fracture", function(s)
+  return (s == "rigid" or s == "elastic" or s == "fracture") and s or nil
+end)
+local seeds = list("seeds", "positive integers", function(s)
+  local v = math.tointeger(tonumber(s))
+  return v and v > 0 and v or nil
+end)
+for _, key in ipairs{"jobs", "threads"} do
+  if math.type(P[key]) ~= "integer" or P[key] < 0 then
+    fail("%s must be a whole number >= 0 (0: automatic), got %s", key, tostring(P[key]))
+  end
+end
+if not (P.size >= 0) then fail("size must be >= 0 m (0: joint.lua's default), got %s", tostring(P.size)) end
+if not (P.normal_stiffness >= 0 and P.normal_stiffness < math.huge) then
+  fail("normal_stiffness must be >= 0 MPa/mm (0: constant normal load), got %s", tostring(P.normal_stiffness))
+end
+if math.type(P.events_every) ~= "integer" or P.events_every < 0 then
+  fail("events_every must be a whole number of steps >= 0 (0: no energy samples), got %s", tostring(P.events_every))
+end
+if not (P.poll > 0) then fail("poll must be > 0 s, got %s", tostring(P.poll)) end
+if not (P.heartbeat >= 0) then fail("heartbeat must be >= 0 s (0: none), got %s", tostring(P.heartbeat)) end
+-- What the runner sets itself may not be given again through `joint`.
+local reserved = {surface = true, stress = true, direction = true, model = true, seed = true, out = true,
+                  threads = true, cache = true, size = true, progress = true, normal_control = true,
+                  normal_stiffness = true, events_every = true}
+local extra = {}
+for item in P.joint:gmatch("%S+") do
+  local k, v = item:match("^([%a_][%w_]*)=(.*)$")
+  if not k then fail("joint: '%s' is not of the form key=value", item) end
+  if reserved[k] then
+    fail("joint: '%s' is set by the study itself (use its own parameter%s)", k,
+         (k == "surface" or k == "stress" or k == "direction" or k == "model" or k == "seed") and "s, e.g. " .. k .. "s=" or "")
+  end
+  extra[#extra + 1] = item
+end
+
+local function shell_quote(s)
+  s = tostring(s)
+  if s:match("^[%w%%%+,%-%./:=@_]+$") then return s end
+  return "'" .. s:gsub("'", "'\\''") .. "'"
+end
+local function capture(cmd)
+  local p = assert(io.popen(cmd, "r"))
+  local text = p:read("a")
+  p:close()
+  return (text:gsub("%s+$", ""))
+end
+-- Absolute paths: the commands must mean the same from any directory (a Slurm task's too).
+local cwd = capture("pwd")
+local function absolute(path) return path:sub(1, 1) == "/" and path or (cwd .. "/" .. path) end
+local DIR = absolute(P.out):gsub("/+$", ""):gsub("/%./", "/")
+-- The program: the one running this script ($PPID of a shell it starts), unless told.
+local exe = P.asperity ~= "" and absolute(P.asperity) or capture("readlink -f /proc/$PPID/exe")
+local joint_script = absolute(asperity.scripts_dir) .. "/joint.lua"
+
+-- The runs ---------------------------------------------------------------------------------------
+-- Surface statistics (surfaces.md 4), from the generator's own table.
+local surface_stats = {}
+for k = 1, 8 do
+  local name = "S" .. k
+  local p = asperity.surface.generate{name = name, n = 9, side = 0.01, seed = 1}:params()
+  surface_stats[name] = {H = p.H, Lc_mm = p.Lc * 1e3, s2_mm2 = p.variance * 1e6}
+end
+
+local function run_name(surface, stress, direction, model, seed)
+  return ("%s_%g_%s_%s_s%d"):format(surface, stress, direction, model, seed)
+end
+-- The inverse, for folders found on disk (collect).
+local function parse_name(name)
+  local surface, stress, direction, model, seed = name:match("^(S%d)_([%d%.e%+%-]+)_([xy])_(%a+)_s(%d+)$")
+  if not surface then return nil end
+  return {name = name, surface = surface, stress = tonumber(stress), direction = direction, model = model,
+          seed = tonumber(seed)}
+end
+
+local runs = {}
+for _, seed in ipairs(seeds) do
+  for _, surface in ipairs(surfaces) do
+    for _, stress in ipairs(stresses) do
+      for _, direction in ipairs(directions) do
+        for _, model in ipairs(models) do
+          runs[#runs + 1] = {name = run_name(surface, stress, direction, model, seed), surface = surface,
+                             stress = stress, direction = direction, model = model, seed = seed,
+                             group = surface .. "_s" .. seed}
+        end
+      end
+    end
+  end
+end
+
+-- Cores, jobs, threads.
+local cores = tonumber(capture("nproc 2>/dev/null")) or 1
+local jobs, threads = P.jobs, P.threads
+if jobs == 0 and threads == 0 then threads = 1 end
+if jobs == 0 then jobs = math.max(1, cores // threads) end
+if threads == 0 then threads = math.max(1, cores // jobs) end
+
+-- The shortest decimal that reads back as the same double.
+local function number_text(v)
+  for digits = 6, 17 do
+    local t = ("%." .. digits .. "g"):format(v)
+    if tonumber(t) == v then return t end
+  end
+  return ("%.17g"):format(v)
+end
+
+-- The command line of one run: the same string here and in the Slurm script.
+local function command(run)
+  local args = {exe, "run", joint_script, "surface=" .. run.surface, "stress=" .. number_text(run.stress),
+                "direction=" .. run.direction, "model=" .. run.model, "seed=" .. run.seed}
+  if P.size > 0 then args[#args + 1] = "size=" .. number_text(P.size) end
+  if P.normal_stiffness > 0 then
+    args[#args + 1] = "normal_control=stiffness"
+    args[#args + 1] = "normal_stiffness=" .. number_text(P.normal_stiffness)
+  end
+  if run.model == "fracture" and P.events_every > 0 then args[#args + 1] = "events_every=" .. P.events_every end
+  for _, item in ipairs(extra) do args[#args + 1] = item end
+  args[#args + 1] = "threads=" .. threads
+  args[#args + 1] = "progress=false"
+  args[#args + 1] = "cache=" .. DIR .. "/cache"
+  args[#args + 1] = "out=" .. DIR .. "/" .. run.name .. ".part"
+  for k, a in ipairs(args) do args[k] = shell_quote(a) end
+  return table.concat(args, " ")
+end
+
+-- Files ------------------------------------------------------------------------------------------
+local function exists(path)
+  local f = io.open(path, "r")
+  if f then f:close() return true end
+  return false
+end
+local function read_text(path)
+  local f = io.open(path, "r")
+  if not f then return nil end
+  local t = f:read("a")
+  f:close()
+  return t
+end
+-- Written to a temporary name and renamed, so no reader ever sees half a file.
+local function write_atomic(path, text)
+  local tmp = path .. ".tmp"
+  local f = assert(io.open(tmp, "w"))
+  f:write(text)
+  f:close()
+  assert(os.rename(tmp, path))
+end
+
+-- The wrapper that runs one command and renames its folder (POSIX sh; flock from util-linux keeps
+-- two processes from running one run, e.g. a resumed runner and the last run of a killed one).
+local RUN_SH = [=[#!/bin/sh
+# One run of a study, written by scripts/study.lua (the runner and its Slurm script both call it):
+#
+#   run.sh NAME WATCH_PID RETRY 'COMMAND'
+#
+# Runs COMMAND (an `asperity run .../joint.lua ... out=STUDY/NAME.part` line) with its output in
+# STUDY/NAME.part/log.txt. On success (exit 0 and a summary.json) the folder is renamed to
+# STUDY/NAME, so a folder STUDY/NAME is always a finished run and a finished run is skipped; on
+# failure to STUDY/NAME.failed, with exit_status, which is skipped too unless RETRY is 1. A run
+# ended by a signal (kill, Ctrl-C: status above 128) stays STUDY/NAME.part and starts again next
+# time. WATCH_PID > 0: a process (the runner) whose end stops the run too.
+set -u
+study=$(cd "$(dirname "$0")/.." && pwd)
+name=$1
+watch=$2
+retry=$3
+cmd=$4
+final="$study/$name"
+part="$final.part"
+failed="$final.failed"
+mkdir -p "$study/.study/locks"
+exec 9>"$study/.study/locks/$name"
+flock -w 600 9 || { echo "run.sh: $name is locked by another process" >&2; exit 75; }
+[ -f "$final/summary.json" ] && exit 0
+[ "$retry" = 1 ] || [ ! -f "$failed/exit_status" ] || exit 0
+rm -rf "$part"
+mkdir -p "$part"
+printf '%s\n' "$cmd" > "$part/command.txt"
+sh -c "exec $cmd" > "$part/log.txt" 2>&1 9>&- &
+child=$!
+# A process that has ended but not been reaped yet (a zombie) still answers kill -0: read its state.
+alive() {
+  if [ -r "/proc/$1/stat" ]; then
+    state=$(sed 's/^.*) //' "/proc/$1/stat" 2>/dev/null | cut -c1)
+    [ -n "$state" ] && [ "$state" != Z ]
+  else
+    kill -0 "$1" 2>/dev/null
+  fi
+}
+if [ "$watch" -gt 0 ]; then
+  while kill -0 "$child" 2>/dev/null; do
+    if ! alive "$watch"; then
+      kill "$child" 2>/dev/null
+      wait "$child"
+      exit 143
+    fi
+    sleep 0.2
+  done
+fi
+wait "$child"
+status=$?
+if [ "$status" -eq 0 ] && [ -f "$part/summary.json" ]; then
+  rm -rf "$failed" "$final"
+  mv "$part" "$final"
+elif [ "$status" -gt 128 ]; then
+  exit "$status"
+else
+  echo "$status" > "$part/exit_status"
+  rm -rf "$failed"
+  mv "$part" "$failed"
+fi
+]=]
+
+-- The state of a run on disk: finished, failed, interrupted (a .part left) or pending.
+local function state_of(name)
+  if exists(DIR .. "/" .. name .. "/summary.json") then return "finished" end
+  if exists(DIR .. "/" .. name .. ".failed/exit_status") then return "failed" end
+  if exists(DIR .. "/" .. name .. ".part/command.txt") then return "interrupted" end
+  return "pending"
+end
+-- A failed run's message: the error line joint.lua's process printed (the line before the
+-- traceback), else its last line.
+local function failure_message(folder)
+  local text = read_text(folder .. "/log.txt") or ""
+  local lines = {}
+  for line in text:gmatch("[^\n]+") do lines[#lines + 1] = line end
+  for k = 2, #lines do
+    if lines[k]:match("^stack traceback:") then return lines[k - 1] end
+  end
+  local status = read_text(folder .. "/exit_status")
+  return lines[#lines] or ("exit status " .. tostring(status and status:gsub("%s", "")))
+end
+
+-- Tables -----------------------------------------------------------------------------------------
+local function flatten(t, prefix, out)
+  for k, v in pairs(t) do
+    if type(k) == "string" and k ~= "parameters" then
+      local key = prefix .. k
+      if type(v) == "table" and v ~= json.null then
+        if next(v) ~= nil and v[1] == nil then flatten(v, key .. "_", out) end
+      elseif v == json.null then
+        out[key] = 0/0
+      elseif type(v) == "number" or type(v) == "boolean" or type(v) == "string" then
+        out[key] = v
+      end
+    end
+  end
+  return out
+end
+
+local FIXED = {"name", "surface", "H", "Lc_mm", "s2_mm2", "stress_mpa", "direction", "model", "seed",
+               "cns_stiffness_mpa_per_mm", "status", "message"}
+
+-- Every run folder under DIR (finished, failed, interrupted) and every requested run not yet
+-- there, one row each: what collect=true and the runner both write.
+local function gather(requested)
+  local names, seen = {}, {}
+  local listing = io.popen("ls -1 " .. shell_quote(DIR) .. " 2>/dev/null")
+  for entry in listing:lines() do
+    local base = entry:gsub("%.part$", ""):gsub("%.failed$", "")
+    if parse_name(base) and not seen[base] then seen[base] = true; names[#names + 1] = base end
+  end
+  listing:close()
+  for _, run in ipairs(requested or {}) do
+    if not seen[run.name] then seen[run.name] = true; names[#names + 1] = run.name end
+  end
+  local rows = {}
+  for _, name in ipairs(names) do
+    local id = parse_name(name)
+    local stats = surface_stats[id.surface]
+    local row = {name = name, surface = id.surface, H = stats.H, Lc_mm = stats.Lc_mm, s2_mm2 = stats.s2_mm2,
+                 stress_mpa = id.stress, direction = id.direction, model = id.model, seed = id.seed,
+                 cns_stiffness_mpa_per_mm = 0, message = ""}
+    local state = state_of(name)
+    row.status = state
+    if state == "finished" then
+      local ok, summary = pcall(json.read, DIR .. "/" .. name .. "/summary.json")
+      if ok then
+        flatten(summary, "", row)
+        local p = summary.parameters or {}
+        if p.normal_control == "stiffness" then row.cns_stiffness_mpa_per_mm = p.normal_stiffness end
+        row.size = p.size
+      else
+        row.status, row.message = "failed", "unreadable summary.json: " .. tostring(summary)
+      end
+    elseif state == "failed" then
+      row.message = failure_message(DIR .. "/" .. name .. ".failed")
+    end
+    rows[#rows + 1] = row
+  end
+  -- Ordered as the study lists them: seed, surface, stress, direction, model.
+  local model_rank = {rigid = 1, elastic = 2, fracture = 3}
+  table.sort(rows, function(a, b)
+    if a.seed ~= b.seed then return a.seed < b.seed end
+    if a.surface ~= b.surface then return a.surface < b.surface end
+    if a.stress_mpa ~= b.stress_mpa then return a.stress_mpa < b.stress_mpa end
+    if a.direction ~= b.direction then return a.direction < b.direction end
+    return (model_rank[a.model] or 9) < (model_rank[b.model] or 9)
+  end)
+  return rows
+end
+
+local function columns_of(rows)
+  local fixed, cols, seen = {}, {}, {}
+  for _, c in ipairs(FIXED) do fixed[c] = true; cols[#cols + 1] = c end
+  local more = {}
+  for _, row in ipairs(rows) do
+    for k in pairs(row) do
+      if not fixed[k] and not seen[k] then seen[k] = true; more[#more + 1] = k end
+    end
+  end
+  table.sort(more)
+  for _, k in ipairs(more) do cols[#cols + 1] = k end
+  return cols
+end
+
+local function csv_field(v)
+  if v == nil then return "" end
+  if type(v) == "number" then
+    if v ~= v then return "nan" end
+    if math.type(v) == "integer" then return tostring(v) end
+    return ("%.10g"):format(v)
+  end
+  local s = tostring(v)
+  if s:find('[,"\n]') then s = '"' .. s:gsub('"', '""') .. '"' end
+  return s
+end
+
+local function write_tables(rows)
+  local cols = columns_of(rows)
+  local lines = {table.concat(cols, ",")}
+  for _, row in ipairs(rows) do
+    local f = {}
+    for k, c in ipairs(cols) do f[k] = csv_field(row[c]) end
+    lines[#lines + 1] = table.concat(f, ",")
+  end
+  write_atomic(DIR .. "/study.csv", table.concat(lines, "\n") .. "\n")
+  write_atomic(DIR .. "/study.json", asperity.json({columns = cols, runs = rows}))
+end
+
+local function finish(rows)
+  local failed = 0
+  for _, row in ipairs(rows) do if row.status == "failed" then failed = failed + 1 end end
+  if P.report then
+    local ok, err = pcall(function() require("study_report").write{dir = DIR, rows = rows, log = log} end)
+    if not ok then log("report not complete: %s", tostring(err)) end
+  end
+  return failed
+end
+
+asperity.mkdir(DIR)
+
+-- collect=true: tables and report from the folders ------------------------------------------------
+if P.collect then
+  local rows = gather(nil)
+  write_tables(rows)
+  local failed = finish(rows)
+  log("collected %d runs from %s (%d failed): study.csv, study.json", #rows, DIR, failed)
+  os.exit(math.min(failed, 100))
+end
+
+asperity.mkdir(DIR .. "/.study")
+write_atomic(DIR .. "/.study/run.sh", RUN_SH)
+-- The run names do not carry the settings every run shares, so a folder holds one study: a later
+-- invocation with other settings would skip runs made differently and mix them in one table.
+do
+  local settings = {size = P.size, joint = table.concat(extra, " "), normal_stiffness = P.normal_stiffness,
+                    events_every = P.events_every}
+  local path = DIR .. "/.study/settings.json"
+  if exists(path) then
+    local before = json.read(path)
+    for _, k in ipairs{"size", "joint", "normal_stiffness", "events_every"} do
+      if before[k] ~= settings[k] then
+        fail("%s holds a study made with %s=%s, not %s: give another out= (or the same %s)", DIR, k,
+             tostring(before[k]), tostring(settings[k]), k)
+      end
+    end
+  else
+    write_atomic(path, asperity.json(settings))
+  end
+end
+
+-- slurm=FILE: a job array instead of running ----------------------------------------------------
+-- Two arrays: the packers (one run per surface and seed, which packs and caches the specimen),
+-- then every other run, started once the packers have ended (afterany: a packer that failed
+-- leaves its specimen to the first run that needs it).
+if P.slurm ~= "" then
+  local packers, others, have = {}, {}, {}
+  for _, run in ipairs(runs) do
+    if not have[run.group] then
+      -- The cheapest run of the group packs: rigid if the study has it.
+      local best = run
+      for _, r in ipairs(runs) do
+        if r.group == run.group and r.model == "rigid" then best = r; break end
+      end
+      have[run.group] = best
+      packers[#packers + 1] = best
+    end
+  end
+  for _, run in ipairs(runs) do
+    if have[run.group] ~= run then others[#others + 1] = run end
+  end
+  local function cases(list)
+    local t = {}
+    for k, run in ipairs(list) do
+      t[#t + 1] = ("    %d) name=%s; cmd=%s ;;"):format(k - 1, run.name, shell_quote(command(run)))
+    end
+    return table.concat(t, "\n")
+  end
+  local text = ([=[#!/bin/bash
+# A Slurm job array for a study of asperity (written by scripts/study.lua; see scripts/README.md).
+#
+#   bash %s              submits: the packing array, then the run array after it
+#   study %s: %d packing runs (one per surface and seed), then %d; %d threads per run
+#
+# Every task runs one joint.lua command through %s/.study/run.sh, the wrapper the runner uses:
+# finished runs are skipped, a run killed part-way starts again when its task runs again, a failed
+# run is kept in NAME.failed (and run again only if the script was written with retry=true).
+# Resubmit the same file to resume; gather the results on any machine with:
+#   asperity run scripts/study.lua collect=true out=%s
+#SBATCH --job-name=asperity-study
+#SBATCH --ntasks=1
+#SBATCH --cpus-per-task=%d
+#SBATCH --output=%s/.study/slurm-%%A_%%a.out
+set -u
+study=%s
+if [ -z "${SLURM_ARRAY_TASK_ID:-}" ]; then
+  pack=$(sbatch --parsable --array=0-%d "$0" pack) || exit 1
+  runs=%s
+  echo "packing: job $pack"
+  if [ "$runs" -gt 0 ]; then
+    sbatch --parsable --array=0-$((runs - 1)) --dependency=afterany:"$pack" "$0" run || exit 1
+  fi
+  exit 0
+fi
+task=$SLURM_ARRAY_TASK_ID
+case "${1:-}" in
+pack)
+  case "$task" in
+%s
+    *) echo "no packing task $task" >&2; exit 2 ;;
+  esac ;;
+run)
+  case "$task" in
+%s
+    *) echo "no run task $task" >&2; exit 2 ;;
+  esac ;;
+*) echo "usage: bash $0 (submits), or as an array task with the argument pack or run" >&2; exit 2 ;;
+esac
+exec sh "$study/.study/run.sh" "$name" 0 %d "$cmd"
+]=]):format(P.slurm, DIR, #packers, #others, threads, DIR, DIR, threads, DIR, shell_quote(DIR),
+             #packers - 1, #others, cases(packers), cases(others), P.retry and 1 or 0)
+  write_atomic(P.slurm, text)
+  log("wrote %s: %d runs (%d packing, then %d), %d threads each; submit with: bash %s",
+      P.slurm, #runs, #packers, #others, threads, P.slurm)
+  return
+end
+
+-- The runner -------------------------------------------------------------------------------------
+local my_pid = tonumber(capture("echo $PPID"))
+local t0 = asperity.wall_time()
+local function clock(seconds)
+  if seconds ~= seconds or seconds == math.huge then return "?" end
+  seconds = math.max(0, math.floor(seconds + 0.5))
+  if seconds < 60 then return seconds .. " s" end
+  if seconds < 3600 then return ("%d min %02d s"):format(seconds // 60, seconds % 60) end
+  return ("%d h %02d min"):format(seconds // 3600, seconds % 3600 // 60)
+end
+local function sleep(seconds)
+  -- Through popen, not os.execute: system() ignores SIGINT in the caller, so a Ctrl-C during the
+  -- wait would not reach this script.
+  local p = io.popen(("sleep %.3f"):format(seconds))
+  p:read("a")
+  p:close()
+end
+
+local pending, ready, todo = {}, {}, 0
+local finished_before, failed_before = 0, 0
+for _, run in ipairs(runs) do
+  local state = state_of(run.name)
+  if state == "finished" then
+    ready[run.group] = true
+    finished_before = finished_before + 1
+  elseif state == "failed" and not P.retry then
+    failed_before = failed_before + 1
+  else
+    pending[#pending + 1] = run
+    run.restart = state == "interrupted"
+  end
+end
+todo = #pending
+log("%d runs in %s: %d finished before, %d failed before%s, %d to run; %d jobs x %d threads (%d cores)",
+    #runs, DIR, finished_before, failed_before, failed_before > 0 and " (skipped; retry=true runs them again)" or "",
+    todo, jobs, threads, cores)
+write_tables(gather(runs))
+
+-- Wall time per model, for the estimates (packing runs separately: they include the packing).
+local times = {}
+local function estimate(run, packs)
+  local function mean(key)
+    local t = times[key]
+    if not t or #t == 0 then return nil end
+    local s = 0
+    for _, v in ipairs(t) do s = s + v end
+    return s / #t
+  end
+  if packs then return mean(run.model .. "+pack") or mean("any+pack") or mean(run.model) or mean("any") end
+  return mean(run.model) or mean("any") or mean(run.model .. "+pack") or mean("any+pack")
+end
+
+local running, done, failed_now = {}, 0, 0
+local last_heartbeat = asperity.wall_time()
+local function started_count() local n = 0 for _ in pairs(running) do n = n + 1 end return n end
+local function overall_left()
+  local total, known = 0, true
+  -- One packer for each group not packed yet (unless one is running), the others after it.
+  local packing = {}
+  for _, job in pairs(running) do if job.packs then packing[job.run.group] = true end end
+  for _, run in ipairs(pending) do
+    local packs = not ready[run.group] and not packing[run.group]
+    if packs then packing[run.group] = true end
+    local e = estimate(run, packs)
+    if e then total = total + e else known = false end
+  end
+  local now = asperity.wall_time()
+  for _, job in pairs(running) do
+    local e = estimate(job.run, job.packs)
+    if e then total = total + math.max(0, e - (now - job.t)) else known = false end
+  end
+  if not known then return "time left not known yet" end
+  return "about " .. clock(total / jobs) .. " left"
+end
+
+local function start(run, packs)
+  local line = ("sh %s %s %d %d %s >/dev/null 2>&1 & echo $!"):format(shell_quote(DIR .. "/.study/run.sh"),
+    shell_quote(run.name), my_pid, P.retry and 1 or 0, shell_quote(command(run)))
+  local pid = tonumber(capture(line))
+  if not pid then fail("could not start the run %s", run.name) end
+  running[run.name] = {run = run, pid = pid, t = asperity.wall_time(), packs = packs}
+  local e = estimate(run, packs)
+  log("started %s%s%s (%d of %d); %s", run.name, packs and " (packs the specimen)" or "",
+      run.restart and " (again: it was interrupted)" or "", done + started_count(), todo,
+      e and ("expected to end at %s (in about %s)"):format(os.date("%H:%M", os.time() + math.floor(e + 0.5)), clock(e))
+        or "no estimate yet")
+end
+
+-- A wrapper is alive while /proc/PID is its run.sh (the pid of an ended one may be reused).
+local function alive(job)
+  local cmdline = read_text("/proc/" .. job.pid .. "/cmdline")
+  return cmdline ~= nil and cmdline:find(job.run.name, 1, true) ~= nil and cmdline:find("run.sh", 1, true) ~= nil
+end
+
+local function next_run()
+  -- A run whose specimen is cached (its group has a finished run) goes first in list order; a
+  -- group with no finished run and nothing running gets one packer (rigid if pending: the cheapest).
+  local busy = {}
+  for _, job in pairs(running) do busy[job.run.group] = true end
+  for k, run in ipairs(pending) do
+    if ready[run.group] then return table.remove(pending, k), false end
+  end
+  for k, run in ipairs(pending) do
+    if not busy[run.group] then
+      for j = k, #pending do
+        if pending[j].group == run.group and pending[j].model == "rigid" then return table.remove(pending, j), true end
+      end
+      return table.remove(pending, k), true
+    end
+  end
+  return nil
+end
+
+local function run_all()
+  while #pending > 0 or next(running) do
+    while started_count() < jobs do
+      local run, packs = next_run()
+      if not run then break end
+      start(run, packs)
+    end
+    sleep(P.poll)
+    -- Between starts and ends of long runs: where the study stands, every `heartbeat` seconds.
+    if P.heartbeat > 0 and asperity.wall_time() - last_heartbeat >= P.heartbeat then
+      last_heartbeat = asperity.wall_time()
+      local now, names = asperity.wall_time(), {}
+      for name, job in pairs(running) do names[#names + 1] = ("%s %s"):format(name, clock(now - job.t)) end
+      table.sort(names)
+      log("%d of %d ended, running: %s; %s", done, todo, table.concat(names, ", "), overall_left())
+    end
+    -- A packer's specimen is cached once joint.lua analyses its DEM surfaces: the other runs of
+    -- its group may start then instead of waiting for its shear (if that line ever changes, they
+    -- wait for the packer to end, as they would anyway).
+    for name, job in pairs(running) do
+      if job.packs and not ready[job.run.group] then
+        local text = read_text(DIR .. "/" .. name .. ".part/log.txt")
+        if text and text:find("[joint] DEM surface:", 1, true) then
+          ready[job.run.group] = true
+          log("specimen of %s ready (packed by %s)", job.run.group, name)
+        end
+      end
+    end
+    local ended = {}
+    for name, job in pairs(running) do
+      if not alive(job) then ended[#ended + 1] = name end
+    end
+    table.sort(ended)
+    for _, name in ipairs(ended) do
+      local job = running[name]
+      running[name] = nil
+      local seconds = asperity.wall_time() - job.t
+      local state = state_of(name)
+      done = done + 1
+      if state == "finished" then
+        ready[job.run.group] = true
+        local key = job.run.model .. (job.packs and "+pack" or "")
+        for _, k in ipairs{key, job.packs and "any+pack" or "any"} do
+          times[k] = times[k] or {}
+          table.insert(times[k], seconds)
+        end
+        local ok, s = pcall(json.read, DIR .. "/" .. name .. "/summary.json")
+        local what = ok and type(s.peak_shear_stress_mpa) == "number" and type(s.residual_shear_stress_mpa) == "number"
+                     and (": peak %.2f MPa, residual %.2f MPa"):format(s.peak_shear_stress_mpa, s.residual_shear_stress_mpa) or ""
+        log("finished %s in %s%s (%d of %d); %s", name, clock(seconds), what, done, todo, overall_left())
+      elseif state == "failed" then
+        failed_now = failed_now + 1
+        log("FAILED %s after %s: %s (%d of %d); %s", name, clock(seconds),
+            failure_message(DIR .. "/" .. name .. ".failed"), done, todo, overall_left())
+      else
+        failed_now = failed_now + 1
+        log("INTERRUPTED %s after %s (stopped by a signal; it starts again on the next run of the study)",
+            name, clock(seconds))
+      end
+      write_tables(gather(runs))
+    end
+  end
+end
+-- Ctrl-C: the runs stop with the runner (their wrappers see it go) and stay NAME.part.
+local ok, err = pcall(run_all)
+if not ok then
+  if tostring(err):find("interrupted") then
+    local names = {}
+    for name in pairs(running) do names[#names + 1] = name end
+    table.sort(names)
+    log("interrupted: %s left part-way (started again by the same command)",
+        #names > 0 and table.concat(names, ", ") or "no run")
+    write_tables(gather(runs))
+    os.exit(130)
+  end
+  error(err, 0)
+end
+
+local rows = gather(runs)
+write_tables(rows)
+finish(rows)
+-- The exit status counts the requested runs that are not finished: failed now or before, or
+-- interrupted.
+local requested = {}
+for _, run in ipairs(runs) do requested[run.name] = true end
+local finished, failed = 0, 0
+for _, row in ipairs(rows) do
+  if requested[row.name] then
+    if row.status == "finished" then finished = finished + 1 else failed = failed + 1 end
+  end
+end
+log("done in %s: %d of %d runs finished, %d not (%d failed or interrupted this time); %s/study.csv, study.json",
+    clock(asperity.wall_time() - t0), finished, #runs, failed, failed_now, DIR)
+os.exit(math.min(failed, 100))

@@ -1,0 +1,140 @@
+-- The study's report (scripts/lib/study_report.lua) on made-up runs whose numbers follow, or break,
+-- the expected behaviours of scenarios.md 7: the verdicts, the comparison counts, the untestable
+-- cases, the mean and scatter over seeds, and the files written.
+local report = require("study_report")
+local json = require("json")
+local out = assert(params.out, "give out=DIRECTORY")
+os.execute("rm -rf '" .. out .. "'")
+asperity.mkdir(out)
+
+-- S5 (H 0.52) against S1 (H 0.75); rigid < fracture < elastic; 21 MPa above 14 MPa; seeds 1 and 2
+-- differ by 10 % (seed 2 higher).
+local H = {S1 = 0.75, S5 = 0.52}
+local base = {rigid = 10, fracture = 12, elastic = 13}
+local rows = {}
+for _, seed in ipairs{1, 2} do
+  for _, surface in ipairs{"S1", "S5"} do
+    for _, stress in ipairs{14, 21} do
+      for _, model in ipairs{"rigid", "elastic", "fracture"} do
+        local peak = base[model] * (surface == "S5" and 1.5 or 1) * stress / 14 * (seed == 2 and 1.1 or 1)
+        rows[#rows + 1] = {
+          name = ("%s_%g_x_%s_s%d"):format(surface, stress, model, seed), status = "finished", surface = surface,
+          H = H[surface], Lc_mm = 16, s2_mm2 = 0.547, stress_mpa = stress, direction = "x", model = model, seed = seed,
+          peak_shear_stress_mpa = peak, residual_shear_stress_mpa = 0.6 * stress * (seed == 2 and 1.1 or 1),
+          initial_shear_stiffness_mpa_per_mm = 50 * stress / 14 + (model == "rigid" and 0 or 30),
+          max_dilatancy_mm = ({rigid = 1.0, elastic = 0.9, fracture = 0.5})[model] * (surface == "S5" and 1.4 or 1) * 14 / stress,
+          broken_bonds = model == "fracture" and (surface == "S5" and 300 or 100) or 0,
+          contact_decay_exponent = -0.5, energy_shares_friction = 0.8, energy_shares_damping = 0.1,
+        }
+      end
+    end
+  end
+end
+rows[#rows + 1] = {name = "S1_14_y_rigid_s1", status = "failed", surface = "S1", stress_mpa = 14, direction = "y",
+                   model = "rigid", seed = 1, message = "boom"}
+-- Curves: a peak at 0.5 mm, then a fall with undulations for rigid and elastic, smooth for fracture;
+-- contacts rise to 1 mm, then fall.
+local curves = {}
+for _, r in ipairs(rows) do
+  if r.status == "finished" then
+    local c = {displacement = {}, shear_stress_mpa = {}, dilatancy = {}, contacts = {}, broken_bonds = {}}
+    for k = 0, 50 do
+      local u = k * 0.1
+      local tau = u <= 0.5 and r.peak_shear_stress_mpa * u / 0.5 or
+                  r.residual_shear_stress_mpa + (r.peak_shear_stress_mpa - r.residual_shear_stress_mpa) * math.exp(-(u - 0.5))
+      if r.model ~= "fracture" and u > 0.5 then tau = tau + 0.5 * math.sin(8 * u) end
+      c.displacement[k + 1], c.shear_stress_mpa[k + 1] = u, tau
+      c.dilatancy[k + 1] = r.max_dilatancy_mm * u / 5
+      c.contacts[k + 1] = u <= 1 and 10 + 20 * u or 30 * u ^ -0.5
+      c.broken_bonds[k + 1] = r.broken_bonds * u / 5
+    end
+    curves[r.name] = c
+  end
+end
+
+local T = {}
+for _, t in ipairs(report.trends(rows, curves)) do T[t.id] = t end
+local function expect(id, verdict, comparisons)
+  local t = assert(T[id], "no trend " .. id)
+  assert(t.verdict == verdict, ("%s: %s, want %s"):format(id, t.verdict, verdict))
+  if comparisons then
+    assert(t.comparisons == comparisons, ("%s: %d comparisons, want %d"):format(id, t.comparisons, comparisons))
+  end
+end
+-- 3 models x 2 stresses x 2 seeds of each S5/S1 pair.
+expect("peak_grows_as_hurst_falls", "shown", 12)
+expect("dilatancy_grows_as_hurst_falls", "shown", 12)
+expect("peak_grows_with_variance", "untestable", 0)
+expect("peak_falls_with_correlation_length", "untestable", 0)
+expect("hurst_strongest", "untestable")
+expect("directions_alike", "untestable", 0)
+expect("stress_peak", "shown", 12)
+expect("stress_residual", "shown", 12)
+expect("stress_initial_shear_stiffness", "shown", 12)
+expect("stress_dilatancy", "shown", 12)
+expect("elastic_above_rigid_peak", "shown", 8)
+expect("fracture_between", "shown", 16)
+expect("dilatancy_by_model", "shown", 16)
+expect("fracture_removes_undulations", "shown", 16)
+expect("contacts_rise_then_decay", "shown", 24)
+expect("breaks_grow_with_roughness", "shown", 4)
+expect("friction_takes_most", "shown", 24)
+-- Residual independent of the surface: here it is (CV 0 across surfaces), while the peak is not.
+expect("residual_independent_of_surface", "shown", 12)
+-- The change goes from the lower H (S5) to the higher (S1): S1 peaks a third below S5.
+assert(math.abs(T.peak_grows_as_hurst_falls.mean_relative_change + 1 / 3) < 1e-12, "S1 peaks a third below S5")
+
+-- One comparison turned round: most still agree.
+local saved = rows[1].peak_shear_stress_mpa       -- S1 14 rigid seed 1
+rows[1].peak_shear_stress_mpa = 100
+T = {}
+for _, t in ipairs(report.trends(rows, curves)) do T[t.id] = t end
+expect("peak_grows_as_hurst_falls", "partly", 12)
+assert(T.peak_grows_as_hurst_falls.agree == 11, "11 of 12 agree")
+-- All turned round: not shown.
+rows[1].peak_shear_stress_mpa = saved
+for _, r in ipairs(rows) do
+  if r.surface == "S1" and r.status == "finished" then r.peak_shear_stress_mpa = 10 * r.peak_shear_stress_mpa end
+end
+T = {}
+for _, t in ipairs(report.trends(rows, curves)) do T[t.id] = t end
+expect("peak_grows_as_hurst_falls", "not shown", 12)
+for _, r in ipairs(rows) do
+  if r.surface == "S1" and r.status == "finished" then r.peak_shear_stress_mpa = r.peak_shear_stress_mpa / 10 end
+end
+
+-- Mean and sample SD over the seeds: peaks p and 1.1 p.
+local cases = report.cases(rows)
+assert(#cases == 12, ("%d cases, want 12"):format(#cases))
+for _, c in ipairs(cases) do
+  assert(c.seeds == 2, "two seeds per case")
+  local p = base[c.model] * (c.surface == "S5" and 1.5 or 1) * c.stress_mpa / 14
+  assert(math.abs(c.peak_shear_stress_mpa_mean - 1.05 * p) < 1e-9 * p, "mean over seeds")
+  assert(math.abs(c.peak_shear_stress_mpa_sd - 0.1 * p / math.sqrt(2)) < 1e-9 * p, "sample SD over seeds")
+end
+
+-- The files, from run folders holding shear.csv.
+for name, c in pairs(curves) do
+  asperity.mkdir(out .. "/" .. name)
+  local f = assert(io.open(out .. "/" .. name .. "/shear.csv", "w"))
+  f:write("displacement [mm],shear_stress_mpa [MPa],dilatancy [mm],contacts [1],broken_bonds [1]\n")
+  for k = 1, #c.displacement do
+    f:write(("%.17g,%.17g,%.17g,%.17g,%.17g\n"):format(c.displacement[k], c.shear_stress_mpa[k], c.dilatancy[k],
+                                                      c.contacts[k], c.broken_bonds[k]))
+  end
+  f:close()
+end
+report.write{dir = out, rows = rows}
+local md = io.open(out .. "/trends.md"):read("a")
+assert(md:find("| peak shear stress grows as H falls | shown | 12 / 12 | mean relative change -33.3 %", 1, true), md)
+assert(md:find("12 cases ran with two or more seeds", 1, true), "the scatter over seeds is reported:\n" .. md)
+assert(md:find("- peak_shear_stress_mpa: 6.7 %", 1, true), "SD / mean of p and 1.1 p is 6.7 %:\n" .. md)
+local tj = json.read(out .. "/trends.json")
+assert(#tj.trends == 21, ("trends.json: %d behaviours"):format(#tj.trends))
+for _, png in ipairs{"shear_fracture_21_x", "models_S5_14", "strength_vs_H_14", "strength_vs_H_21", "shear_stiffness_vs_stress",
+                     "energy_shares_rigid"} do
+  local f = io.open(out .. "/plots/" .. png .. ".png")
+  assert(f, png .. ".png missing")
+  f:close()
+end
+print("PASS")
