@@ -15,10 +15,9 @@
 --
 -- Models [scenarios.md 4]: rigid (each half one rigid body; only particles that can touch the
 -- other half are searched), elastic (unbreakable bonds), fracture (elliptic criterion with the
--- calibrated bond strength; refused while the prepared halves lock more stress into their bonds
--- than that strength, see scripts/README.md; stress_free_bonds=true installs the bonds unloaded,
--- with the REV material calibrated that way). Stresses are reported in model units and scaled to
--- rock [3-37].
+-- calibrated bond strength; refused if the genesis left more than 1 % of the bonds above it).
+-- The halves are made by the REV's genesis (lib/genesis.lua), so they are the calibrated
+-- material. Stresses are reported in model units and scaled to rock [3-37].
 --
 -- Writes into `out`: summary.json; closure.{h5,csv}, shear.{h5,csv}; snapshots (HDF5 + XDMF) at
 -- the displacements in `snapshots`; PNG plots: shear stress and dilatancy, closure curve, contact
@@ -229,7 +228,7 @@ local function build_specimen()
   if P.bond_gap > 0 then bond_material.tolerance = P.bond_gap end
   local walls_list = {mould}
   for _, id in ipairs(planes) do walls_list[#walls_list + 1] = id end
-  local b = genesis.bond(w, {sets = {lower, upper}, material = bond_material, walls = walls_list,
+  local b = genesis.bond(w, {sets = {lower, upper}, material = bond_material, walls = walls_list, steps = 200000,
                              tensile_strength = mat.rev.bond_tensile_strength, progress = P.progress,
                              log = function(fmt, ...) log(fmt, ...) end,
                              before_relax = function(w)

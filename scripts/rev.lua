@@ -5,15 +5,18 @@
 --   build/asperity run scripts/rev.lua tensile_strength=0.03 seed=2 out=out/rev2
 --   build/asperity run scripts/rev.lua rate_check=true out=out/rev_rate   # also at half the rate
 --
--- 1. Packing (pack.expand): N = (1 - n) V / (4/3 pi <R>^3) particles (935), radii Gaussian
---    0.5 +- 0.1 mm cut at 3 SD, radius expansion from 1/10 in frictionless walls, then cycling to
---    the unbalanced-force ratio 1e-4. Then the isotropic stress installation (pack.install_stress):
---    radii scaled by a common factor until the wall stress is `packing_stress` (the stress locked
---    into the packing becomes internal bond stress when the walls go; see below).
--- 2. Two copies of the packing get bonds (every contact; beam_kn = kn, beam_ks = ks): unbreakable
---    (the elastic model: E, nu, G) and breakable with the elliptic criterion of strength st
---    (`tensile_strength`; strengths). Walls removed, cycled to equilibrium. The bond stresses left
---    are reported (histogram, CSV) with the strength each bond needs to hold.
+-- 1. Genesis (lib/genesis.lua, scenarios.md 1): N = (1 - n) V / (4/3 pi <R>^3) particles at the
+--    genesis porosity n (materials.lua), radii Gaussian 0.5 +- 0.1 mm cut at 3 SD, compacted
+--    without friction by radius expansion in frictionless walls; the isotropic stress
+--    `genesis_stress` installed by one radius factor; particles with fewer than 3 contacts taken
+--    out; friction restored. The packing is cached (cache=) for calibrations.
+-- 2. Two copies of the packing get bonds (every contact; beam_kn = kn, beam_ks = bond_shear_ratio
+--    kn, Rb = bond_radius_factor min(Ra, Rb); contacts keep their forces, beams start at zero,
+--    model.md 5): unbreakable (the elastic model: E, nu, G) and breakable with the elliptic
+--    criterion of strength st (`tensile_strength`; strengths). Walls removed, cycled to
+--    equilibrium. The bond stresses left are reported (histogram, CSV) with the strength each bond
+--    needs to hold. Rotation is locked while a particle holds `rotation_lock_bonds` intact bonds.
+--    isotropy: the packing turned so that the z tests load it along x and along y.
 -- 3. Platens: particles within `platen` of the bottom / top face, rigid groups, rotation fixed;
 --    bottom fixed, top moved at `rate`. Stress = platen force / L^2 [3-43, 3-44]; strains from
 --    particle layers at 1/4 and 3/4 height and the lateral faces (specimen.lua) [3-38..3-42].

@@ -59,12 +59,14 @@ end
 -- side by side. Near the jamming point a frictionless packing relaxes slowly; the servo follows
 -- the relaxation instead of waiting for an equilibrium at each trial factor. Done when every set
 -- is within `tolerance` of the target at `settled` updates running and the unbalanced-force
--- ratio is below `ratio`.
+-- ratio is below `ratio`, or, where the assembly creeps along the mould without settling that
+-- far, at `patience` updates running within the tolerance (the ratio reached is reported: the
+-- bonds are installed in that state, and the wall removal cycles it to equilibrium).
 function M.install_stress(world, o)
   local sets, tags, volumes, target = o.sets, o.tags, o.volumes, o.target
   local tol, ratio = o.tolerance or 0.1, o.ratio or 1e-4
-  local every, gain, max_change = o.every or 200, o.gain or 0.5, o.max_change or 2e-3
-  local settled_needed = o.settled or 5
+  local every, gain, max_change = o.every or 200, o.gain or 1, o.max_change or 2e-3
+  local settled_needed, patience = o.settled or 5, o.patience or 250
   local f, p, stiff = {}, {}, {}
   for k = 1, #sets do f[k] = 1 end
   local steps, updates, settled = 0, 0, 0
@@ -88,7 +90,7 @@ function M.install_stress(world, o)
         df = max_change      -- no contact in the set: grow towards jamming
       end
       df = math.max(-max_change, math.min(max_change, df))
-      if math.abs(p[k] - target) > 0.25 * tol * target or stiff[k] == 0 then
+      if math.abs(p[k] - target) > tol * target or stiff[k] == 0 then   -- a dead band: let it settle
         local change = (f[k] + df) / f[k]
         for _, id in ipairs(sets[k]) do world:set_radius(id, world:radius(id) * change) end
         f[k], changed = f[k] + df, true
@@ -104,9 +106,10 @@ function M.install_stress(world, o)
       for k = 1, #sets do t[k] = ("x %.5f: %.4g Pa"):format(f[k], p[k]) end
       o.log("  stress installation, %d steps: %s; ratio %.2g", steps, table.concat(t, ", "), world:unbalanced_force_ratio())
     end
-    if settled >= settled_needed and world:unbalanced_force_ratio() <= ratio then break end
+    if (settled >= settled_needed and world:unbalanced_force_ratio() <= ratio) or settled >= patience then break end
   end
-  return {steps = steps, updates = updates, factors = f, stresses = p, reached = good()}
+  return {steps = steps, updates = updates, factors = f, stresses = p, reached = good(),
+          ratio = world:unbalanced_force_ratio()}
 end
 
 function M.pack(world, o)
@@ -114,7 +117,7 @@ function M.pack(world, o)
             volume = true, stress = true, tolerance = true, friction = true, ratio = true,
             min_contacts = true, floater_tag = true, progress = true, stages = true, stage_steps = true,
             max_steps = true, log = true, wall_contacts = true, split = true, sets_count = true,
-            compaction_ratio = true, compaction_steps = true}, "genesis.pack")
+            compaction_ratio = true, compaction_steps = true, patience = true}, "genesis.pack")
   assert(o.min and o.max and o.radii and o.box, "genesis.pack: min, max, radii and box are required")
   assert(o.stress and o.stress > 0, "genesis.pack: stress (Pa, > 0) is required")
   local log = o.log or function() end
@@ -146,14 +149,16 @@ function M.pack(world, o)
   for k = 1, nsets do p0[k] = world:contact_stress(k, volumes[k]) end
   log("compacted %d particles without friction in %d steps: mean stress %s Pa, coordination %.2f",
       last - first + 1, expanded.steps, table.concat((function() local t = {} for k, v in ipairs(p0) do t[k] = ("%.4g"):format(v) end return t end)(), " / "), expanded.coordination)
-  -- 2. The isotropic stress, by one radius factor per set.
+  -- 2. The isotropic stress, by one radius factor per set, still without friction (unloading with
+  -- friction to the low stress loses a third of the contacts: 32 % floaters, coordination 3.9, on
+  -- the 1 cm REV).
   local s = M.install_stress(world, {sets = sets, tags = tags, volumes = volumes, target = o.stress,
-                                     tolerance = o.tolerance, ratio = ratio, max_steps = o.max_steps,
+                                     tolerance = o.tolerance, ratio = ratio, max_steps = o.max_steps, patience = o.patience,
                                      log = o.progress and log or nil})
   local fs, ps = {}, {}
   for k = 1, nsets do fs[k], ps[k] = ("%.5f"):format(s.factors[k]), ("%.4g"):format(s.stresses[k]) end
-  log("stress installed: radii x %s, mean stress %s Pa (target %.4g) in %d steps%s",
-      table.concat(fs, " / "), table.concat(ps, " / "), o.stress, s.steps,
+  log("stress installed: radii x %s, mean stress %s Pa (target %.4g) in %d steps, unbalanced-force ratio %.2g%s",
+      table.concat(fs, " / "), table.concat(ps, " / "), o.stress, s.steps, s.ratio,
       s.reached and "" or " (NOT reached)")
   -- 3. Floaters out. A particle's contacts with the region's walls count: one held by two
   -- neighbours against a wall is part of the jammed structure (its bonds will hold it once the
@@ -196,7 +201,7 @@ function M.pack(world, o)
     first = first, last = last,
     compaction_steps = expanded.steps, stress_steps = s.steps, steps = expanded.steps + s.steps,
     radius_factor = s.factors[1], radius_factors = s.factors, stress_pa = s.stresses[1], stresses_pa = s.stresses,
-    stress_target_pa = o.stress, stress_reached = s.reached,
+    stress_target_pa = o.stress, stress_reached = s.reached, stress_ratio = s.ratio,
     wall_stress_pa = pack.box_wall_stresses(world, o.box, o.min, o.max),
     coordination = contacts / math.max(1, #kept),   -- ball-ball contacts per kept particle
     porosity_nominal = nominal, porosity_true = true_n, mean_radius = mean,
