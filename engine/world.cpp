@@ -840,6 +840,11 @@ double World::unbalanced_force_ratio() const {
     if (s.pairs.overlap_at(k) > 0) { contact += s.pairs.normal_force(k); ++contacts; }
   for (std::size_t k = 0; k < s.walls.contacts.n; ++k)
     if (s.walls.contacts.overlap[k] > 0) { contact += s.walls.contacts.fn[k]; ++contacts; }
+  // Intact bonds carry contact force too, in tension as well: |contact bond + parallel bond|.
+  for (std::size_t k = 0; k < s.bonds.n; ++k) {
+    contact += std::abs(s.bonds.fn[k] + s.bonds.fbn[k]);
+    ++contacts;
+  }
   if (bodies == 0) return 0;
   // Nothing pushes and nothing is unbalanced (a specimen bonded stress-free): at rest.
   if (contacts == 0 || contact == 0) return unbalanced == 0 ? 0.0 : std::numeric_limits<double>::infinity();

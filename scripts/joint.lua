@@ -312,6 +312,15 @@ for id = 1, N do
   if t == LOWER then lower[#lower + 1] = id elseif t == UPPER then upper[#upper + 1] = id end
 end
 
+-- The upper half's mean height in the frame of the mould (the cached specimen holds it `gap`
+-- higher): break depths are measured from the mean plane in that frame.
+local function mean_height(ids)
+  local ps, z = world:positions(), 0
+  for _, id in ipairs(ids) do z = z + ps:get(id, 3) end
+  return z / math.max(1, #ids)
+end
+local upper_mean_z_mould = mean_height(upper) - P.gap
+
 -- 3. The DEM surfaces: profilometer, mean plane, surface vs porosity particles ---------------
 local pos, rad = world:positions(), world:radii()
 local prof_lower = asperity.surface.profilometer{positions = pos, radii = rad, grid = map,
@@ -428,6 +437,8 @@ else
   bottom = world:add_group(bottom_ids, {translation = "fixed"})
   top = world:add_group(top_ids, {translation = {"fixed", "fixed", "velocity"}, velocity = {0, 0, 0}})
 end
+
+local bonds_at_start = world:bond_count()
 
 -- 5. Assembly: bring the halves together until exactly one contact exists [4.2.1] ------------
 local function between() return world:contact_summary(LOWER, UPPER, POROSITY) end
@@ -734,6 +745,27 @@ local sn_dev_p95 = #devs > 0 and devs[math.max(1, math.ceil(0.95 * #devs))] or 0
 local e = world:energies()
 local input = e.boundary_work - e0.boundary_work
 local function share(v) return input ~= 0 and v / input or 0/0 end
+-- Where the bonds broke [scenarios.md 4: damage near the joint surfaces, not through the halves]:
+-- depth below the mean plane (lower half) or above it (upper half, moved back by its mean
+-- displacement since the genesis), 1 mm bins.
+local broken_by_depth, broken_fraction = nil, nil
+if world:break_count() > 0 or P.model == "fracture" then
+  local shift = mean_height(upper) - upper_mean_z_mould
+  local lower_bins, upper_bins = {}, {}
+  local bins = math.max(1, math.ceil(T * 1e3))
+  for k = 1, bins do lower_bins[k], upper_bins[k] = 0, 0 end
+  for _, ev in ipairs(world:break_events()) do
+    local z = ev.position[3]
+    local upper_side = world:tag(ev.a) == UPPER
+    local depth = upper_side and (z - shift) or -z
+    local k = math.max(1, math.min(bins, math.floor(depth * 1e3) + 1))
+    if upper_side then upper_bins[k] = upper_bins[k] + 1 else lower_bins[k] = lower_bins[k] + 1 end
+  end
+  local edges = {}
+  for k = 1, bins do edges[k] = k end
+  broken_by_depth = {depth_mm_upper_edges = edges, lower = lower_bins, upper = upper_bins}
+  broken_fraction = world:break_count() / math.max(1, bonds_at_start)
+end
 local summary = {
   parameters = P,
   surface = {nx = nx, ny = ny, spacing = h, side_x = Lx, side_y = Ly},
@@ -764,6 +796,8 @@ local summary = {
   normal_stress_deviation_p95 = sn_dev_p95,           -- 95th percentile of the interval-mean deviation
   normal_stress_within_1pct = #devs > 0 and within / #devs or 0/0,  -- fraction of records within 1 %
   broken_bonds = world:break_count(),
+  broken_bond_fraction = broken_fraction,          -- of the bonds the halves held before closure
+  broken_bonds_by_depth_mm = broken_by_depth,      -- counts per 1 mm of depth from the mean plane
   contact_decay_exponent = q,
   max_contacts = cmax,
   dem_surface = {mean_plane_shift_m = plane_lower.shift,

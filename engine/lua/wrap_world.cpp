@@ -1352,7 +1352,8 @@ void open_world(lua_State* L) {
       {"energy_balance", world_energy_balance, "world:energy_balance(initial) -> J",
        "Input work minus stored and dissipated energy since `initial` (a world:energies() table)."},
       {"unbalanced_force_ratio", world_unbalanced_force_ratio, "world:unbalanced_force_ratio() -> r",
-       "Mean unbalanced force / mean contact normal force (equilibrium measure)."},
+       "Mean unbalanced force of the particles outside rigid groups / mean normal force of the\n"
+       "touching contacts, wall contacts and intact bonds (PFC's equilibrium ratio)."},
       {"contacts", world_contacts, "world:contacts() -> {contact, ...}",
        "Touching ball-ball pairs: {a, b, normal, point, overlap, normal_force, shear_force}."},
       {"contact_count", world_contact_count, "world:contact_count() -> n", "Touching ball-ball pairs."},

@@ -306,8 +306,10 @@ class World {
 
   // --- measurements ----------------------------------------------------------------------
   Energies energies() const;              // kinetic and strain computed now; ledgers cumulative
-  // PFC's equilibrium ratio: mean |unbalanced force| over particles / mean contact normal force
-  // (unbonded contacts); 0 when no force acts at all, infinite when forces act but no contact pushes.
+  // PFC's equilibrium ratio: mean |unbalanced force| over the particles outside rigid groups (inert
+  // ones are in groups) / mean normal force of touching contacts, wall contacts and intact bonds
+  // (|contact bond + parallel bond|); 0 when no force acts at all, infinite when forces act but
+  // nothing carries any.
   double unbalanced_force_ratio() const;
   std::vector<ContactInfo> contacts() const;  // touching ball-ball pairs
   std::size_t contact_count() const;

@@ -117,7 +117,7 @@ function M.pack(world, o)
             volume = true, stress = true, tolerance = true, friction = true, ratio = true,
             min_contacts = true, floater_tag = true, progress = true, stages = true, stage_steps = true,
             max_steps = true, log = true, wall_contacts = true, split = true, sets_count = true,
-            compaction_ratio = true, compaction_steps = true, patience = true}, "genesis.pack")
+            compaction_ratio = true, compaction_steps = true, patience = true, stress_ratio = true}, "genesis.pack")
   assert(o.min and o.max and o.radii and o.box, "genesis.pack: min, max, radii and box are required")
   assert(o.stress and o.stress > 0, "genesis.pack: stress (Pa, > 0) is required")
   local log = o.log or function() end
@@ -153,7 +153,7 @@ function M.pack(world, o)
   -- friction to the low stress loses a third of the contacts: 32 % floaters, coordination 3.9, on
   -- the 1 cm REV).
   local s = M.install_stress(world, {sets = sets, tags = tags, volumes = volumes, target = o.stress,
-                                     tolerance = o.tolerance, ratio = ratio, max_steps = o.max_steps, patience = o.patience,
+                                     tolerance = o.tolerance, ratio = o.stress_ratio or mat.genesis.ratio, max_steps = o.max_steps, patience = o.patience,
                                      log = o.progress and log or nil})
   local fs, ps = {}, {}
   for k = 1, nsets do fs[k], ps[k] = ("%.5f"):format(s.factors[k]), ("%.4g"):format(s.stresses[k]) end

@@ -20,7 +20,7 @@ M.packing = {mean_radius = 0.5e-3, radius_sd = 0.1e-3, cut = 3, porosity = 0.51}
 -- definition [3-35] at `porosity` (denser than the thesis's 0.51: a frictionless assembly jams
 -- near 0.45 in a 1 cm box), compacted without friction, the isotropic `stress` installed by a
 -- common radius factor, particles with fewer than `floater_contacts` contacts taken out.
-M.genesis = {porosity = 0.45, stress = 1e-3, floater_contacts = 3}
+M.genesis = {porosity = 0.45, stress = 1e-3, floater_contacts = 3, ratio = 1e-2}
 
 -- Target rock, thesis Table 3-1 (mortar replicas of granite).
 M.rock = {young_modulus = 30853e6, poisson_ratio = 0.187, compressive_strength = 74.6e6,

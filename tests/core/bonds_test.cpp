@@ -406,7 +406,7 @@ TEST(Bonds, StressFreeInstallationLeavesAnOverlappingPairAtRest) {
   EXPECT_EQ(free.energies().strain, 0.0);
   // And the equilibrium ratio says so (no force at all), where the kept pair is out of balance.
   EXPECT_EQ(free.unbalanced_force_ratio(), 0.0);
-  EXPECT_TRUE(std::isinf(kept.unbalanced_force_ratio()));
+  EXPECT_GT(kept.unbalanced_force_ratio(), 0.1);
   const auto info = free.bonds();
   ASSERT_EQ(info.size(), 1u);
   EXPECT_EQ(info[0].normal_force, 0.0);

@@ -5,7 +5,7 @@
 local out = assert(params.out, "give out=DIRECTORY")
 local cache = out .. "/cache"
 local function joint(p)
-  local given = {size = 0.008, thickness = 0.002, shear = 1, pack_steps = 50000, progress = false,
+  local given = {size = 0.008, thickness = 0.003, shear = 1, pack_steps = 50000, progress = false,
                  cache = cache}
   for k, v in pairs(p) do given[k] = v end
   params = given
@@ -58,10 +58,10 @@ for _, key in ipairs{"peak_shear_stress_mpa", "residual_shear_stress_mpa", "max_
 end
 assert(math.abs(fl.energy_balance_error) < 0.01, "float: the energy ledger still closes")
 
--- The fracture model on halves bonded stress-free (nothing locked into the bonds, so the strength
--- check passes): bonds break while shearing, and the energy they held is booked as released, so
--- the ledger still closes.
-local fr = joint{surface = "S1", model = "fracture", stress_free_bonds = true, out = out .. "/S1_fracture"}
+-- The fracture model on the same specimen (the genesis leaves the bonds well below st, so the
+-- strength check passes): bonds break while shearing, the energy they held is booked as
+-- released, so the ledger still closes.
+local fr = joint{surface = "S1", model = "fracture", out = out .. "/S1_fracture"}
 assert(fr.broken_bonds > 0, "the fracture model breaks bonds")
 assert(fr.energy_shares and math.abs(fr.energy_balance_error) < 0.01,
        ("fracture: energy balance error %.3g of the input work"):format(fr.energy_balance_error))
@@ -77,8 +77,9 @@ local packed_file = out .. "/packed_only.h5"
 local po = joint{surface = "S1", model = "elastic", stop_after = "packing", save = packed_file,
                  cache = out .. "/cache_packed_only", out = out .. "/packed_only"}
 assert(po.stopped_after == "packing" and po.saved == packed_file, "stop_after=packing returns the packing")
-assert(po.steps > 0 and po.porosity_nominal > 0.5 and po.porosity_nominal < 0.52,
-       ("packed to porosity %.4f nominal"):format(po.porosity_nominal))
+local mat = require("materials")
+assert(po.steps > 0 and po.porosity_nominal > mat.genesis.porosity and po.porosity_nominal < 0.7,
+       ("packed to porosity %.4f nominal (the genesis count is for %.2f; floaters go)"):format(po.porosity_nominal, mat.genesis.porosity))
 local pw = asperity.load(packed_file, {threads = 1})
 assert(pw:particle_count() == po.particles and po.particles == el.n_particles + el.left_out_particles,
        ("%d particles saved, %d in the elastic joint's packing"):format(pw:particle_count(), el.n_particles + el.left_out_particles))
@@ -92,7 +93,7 @@ print(("S4 peak %.3g MPa, S5 peak %.3g MPa; elastic S1: balance error %.2g, fric
 print(("float S1 elastic: peak %.5g (double %.5g), residual %.5g (%.5g), dilatancy %.5g (%.5g) mm"):format(
   fl.peak_shear_stress_mpa, el.peak_shear_stress_mpa, fl.residual_shear_stress_mpa,
   el.residual_shear_stress_mpa, fl.max_dilatancy_mm, el.max_dilatancy_mm))
-print(("fracture S1 (stress-free bonds): peak %.3g MPa, %d broken bonds, balance error %.2g"):format(
+print(("fracture S1: peak %.3g MPa, %d broken bonds, balance error %.2g"):format(
   fr.peak_shear_stress_mpa, fr.broken_bonds, fr.energy_balance_error))
 print(("[figure] normal stress held: p95 deviation S4 %.4f S5 %.4f S1 elastic %.4f; within 1 %%: %.3f %.3f %.3f; max %.3f %.3f %.3f"):format(
   s4.normal_stress_deviation_p95, s5.normal_stress_deviation_p95, el.normal_stress_deviation_p95,

@@ -3,7 +3,7 @@
 -- same joint under constant normal load does not (so the check can tell the two apart).
 local out = assert(params.out, "give out=DIRECTORY")
 local function joint(p)
-  local given = {size = 0.008, thickness = 0.002, shear = 1, pack_steps = 50000, progress = false,
+  local given = {size = 0.008, thickness = 0.003, shear = 1, pack_steps = 50000, progress = false,
                  surface = "S1", model = "elastic", cache = out .. "/cache"}
   for k, v in pairs(p) do given[k] = v end
   params = given

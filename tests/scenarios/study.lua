@@ -28,7 +28,7 @@ end
 -- 1. The reduced study.
 local dir = out .. "/study"
 local args = ("surfaces=S1,S5 stresses=14 directions=x models=rigid,elastic jobs=2 threads=1 size=0.008 " ..
-              "out='%s' joint='thickness=0.002 shear=1 pack_steps=50000'"):format(dir)
+              "out='%s' joint='thickness=0.003 shear=1 pack_steps=50000'"):format(dir)
 local t0 = asperity.wall_time()
 local status, log = run(args, out .. "/study.log")
 print(("reduced study: exit %d in %.1f s"):format(status, asperity.wall_time() - t0))
@@ -51,7 +51,7 @@ for _, row in ipairs(t.runs) do
   assert(row.energy_shares_friction == s.energy_shares.friction, row.name .. ": nested scalars flattened")
   assert(row.H == (row.surface == "S1" and 0.75 or 0.52) and row.Lc_mm == 16 and row.s2_mm2 == 0.547,
          row.name .. ": surface statistics")
-  assert(s.parameters.threads == 1 and s.parameters.thickness == 0.002 and s.parameters.size == 0.008,
+  assert(s.parameters.threads == 1 and s.parameters.thickness == 0.003 and s.parameters.size == 0.008,
          row.name .. ": the runner's parameters reach joint.lua")
 end
 assert(read(dir .. "/study_cases.csv"):find("\nS5,14,x,elastic,1,"), "study_cases.csv has the S5 elastic case")
@@ -78,7 +78,7 @@ assert(md:find("| peak shear stress grows as H falls | ", 1, true) and md:find("
 -- The fracture study, for the event statistics (events_every=100 by default for fracture runs).
 local fdir = out .. "/fracture"
 status, log = run(("surfaces=S1 stresses=14 directions=x models=fracture jobs=1 threads=1 size=0.008 " ..
-                   "out='%s' joint='thickness=0.002 shear=1 pack_steps=50000 stress_free_bonds=true'"):format(fdir),
+                   "out='%s' joint='thickness=0.003 shear=1 pack_steps=50000'"):format(fdir),
                   out .. "/fracture.log")
 assert(status == 0, "the fracture study failed:\n" .. log)
 local evs = json.read(fdir .. "/events/events.json")
@@ -101,7 +101,7 @@ assert(status == 0 and read(dir .. "/study.csv") == csv, "collect=true rebuilds 
 
 -- The folder holds one study: other shared settings are refused.
 status, log = run(args:gsub("pack_steps=50000", "pack_steps=60000"), out .. "/other.log")
-assert(status == 1 and log:find("holds a study made with joint=thickness=0.002 shear=1 pack_steps=50000", 1, true), log)
+assert(status == 1 and log:find("holds a study made with joint=thickness=0.003 shear=1 pack_steps=50000", 1, true), log)
 
 -- 2. Failures: recorded with the message, the others still run, exit status = their number.
 local bad = out .. "/bad"

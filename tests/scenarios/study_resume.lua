@@ -10,7 +10,7 @@ asperity.mkdir(out)
 local exe = io.popen("readlink -f /proc/$PPID/exe"):read("l")
 local study = asperity.scripts_dir .. "/study.lua"
 local cmd = ("'%s' run '%s' surfaces=S1 stresses=14 directions=x,y models=rigid,elastic jobs=1 threads=1 " ..
-             "report=false size=0.008 out='%s' joint='thickness=0.002 shear=1 pack_steps=50000 velocity=5e-6'")
+             "report=false size=0.008 out='%s' joint='thickness=0.003 shear=1 pack_steps=50000 velocity=5e-6'")
             :format(exe, study, dir)
 local names = {"S1_14_x_rigid_s1", "S1_14_x_elastic_s1", "S1_14_y_rigid_s1", "S1_14_y_elastic_s1"}
 
