@@ -90,7 +90,8 @@ function M.install_stress(world, o)
         df = max_change      -- no contact in the set: grow towards jamming
       end
       df = math.max(-max_change, math.min(max_change, df))
-      if math.abs(p[k] - target) > tol * target or stiff[k] == 0 then   -- a dead band: let it settle
+      -- a dead band of half the tolerance: the set settles, and stays centred in the tolerance
+      if math.abs(p[k] - target) > 0.5 * tol * target or stiff[k] == 0 then
         local change = (f[k] + df) / f[k]
         for _, id in ipairs(sets[k]) do world:set_radius(id, world:radius(id) * change) end
         f[k], changed = f[k] + df, true
