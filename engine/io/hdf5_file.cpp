@@ -37,13 +37,30 @@ void write_dataset(hid_t parent, const std::string& name, std::span<const T> dat
 
 void quiet_errors() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
 
-Handle create_file(const std::filesystem::path& path) {
+Handle create_file(const std::filesystem::path& path, std::size_t userblock) {
   quiet_errors();
   Handle props(H5Pcreate(H5P_FILE_CREATE), H5Pclose);
   H5Pset_link_creation_order(props, H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED);
-  Handle f(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, props, H5P_DEFAULT), H5Fclose);
+  if (userblock > 0 && H5Pset_userblock(props, userblock) < 0) fail(path.string(), "bad user block size");
+  Handle access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  if (H5Pset_fapl_core(access, 1 << 20, 0) < 0) fail(path.string(), "cannot set up an in-memory file");
+  Handle f(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, props, access), H5Fclose);
   if (!f.valid()) fail(path.string(), "cannot create");
   return f;
+}
+
+std::vector<unsigned char> file_image(hid_t file, const std::string& name) {
+  if (H5Fflush(file, H5F_SCOPE_GLOBAL) < 0) fail(name, "flush failed");
+  const ssize_t size = H5Fget_file_image(file, nullptr, 0);
+  if (size <= 0) fail(name, "cannot take the file image");
+  std::vector<unsigned char> image(static_cast<std::size_t>(size));
+  if (H5Fget_file_image(file, image.data(), image.size()) != size) fail(name, "cannot take the file image");
+  return image;
+}
+
+void write_image(hid_t file, const std::filesystem::path& temp, const std::string& name) {
+  const std::vector<unsigned char> image = file_image(file, name);
+  write_bytes(temp, image, name);
 }
 
 Handle open_file_read(const std::filesystem::path& path) {

@@ -50,9 +50,17 @@ class Handle {
 
 void quiet_errors();
 
-// A new file (truncating), for writing. Tracks link creation order so datasets list in the order
-// they were written.
-Handle create_file(const std::filesystem::path& path);
+// A new file for writing, built in memory (HDF5's core driver without a backing store) and put on
+// disk by write_image: HDF5 itself then never writes to the disk, so a full disk is an error of
+// ours, raised before the rename. (A failed H5Fclose on a full disk leaves HDF5 with a file it
+// cannot close, and its clean-up at exit crashes.) Tracks link creation order so datasets list
+// in the order they were written. userblock: bytes reserved at the start (0, or a power of two
+// >= 512) for a header of the caller's.
+Handle create_file(const std::filesystem::path& path, std::size_t userblock = 0);
+// The complete file image of a file from create_file (flushed first).
+std::vector<unsigned char> file_image(hid_t file, const std::string& name);
+// file_image written to `temp` (an AtomicFile's temporary path) with every write checked.
+void write_image(hid_t file, const std::filesystem::path& temp, const std::string& name);
 Handle open_file_read(const std::filesystem::path& path);
 Handle create_group(hid_t parent, const std::string& name, const std::string& file);
 

@@ -662,7 +662,7 @@ int world_install_bonds(lua_State* L) {
 int world_save(lua_State* L) {
   return guarded(L, [&] {
     World& w = world_arg(L);
-    const char* path = luaL_checkstring(L, 2);
+    const std::string path = check_string(L, 2);
     w.save(path);
     return 0;
   });
@@ -670,7 +670,7 @@ int world_save(lua_State* L) {
 
 int l_load(lua_State* L) {
   return guarded(L, [&] {
-    const std::string path = luaL_checkstring(L, 1);
+    const std::string path = check_string(L, 1);
     int threads = 0;
     std::string simd = "auto";
     if (!lua_isnoneornil(L, 2)) {

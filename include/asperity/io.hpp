@@ -55,6 +55,11 @@ class AtomicFile {
 };
 
 void write_text_file(const std::filesystem::path& path, std::string_view contents);
+// Writes `bytes` to `temp` (an AtomicFile's temporary path) with every write and the close
+// checked, so that a full disk or a file-size limit is an Error naming `target`, never a short
+// file that looks complete. sync: also flush it to the device before returning (checkpoints).
+void write_bytes(const std::filesystem::path& temp, std::span<const unsigned char> bytes,
+                 const std::string& target, bool sync = false);
 // mkdir -p; an existing directory is fine, an existing file of that name is an Error.
 void make_directories(const std::filesystem::path& path);
 
