@@ -135,7 +135,9 @@ World::World(WorldSettings settings) : state_(std::make_unique<State>()) {
   require(settings.dt_safety >= kMinDtSafety && settings.dt_safety <= 1,
           "dt_safety " + num(settings.dt_safety) + " outside [" + num(kMinDtSafety) + ", 1]");
   require(settings.dt_interval >= 1, "dt_interval must be >= 1");
-  require(settings.threads >= 0, "threads must be >= 0 (0: all cores)");
+  require(settings.threads >= 0 && settings.threads <= kMaxThreads,
+          "threads " + std::to_string(settings.threads) + " outside 0.." + std::to_string(kMaxThreads) +
+              " (0: automatic)");
   require(settings.reorder_interval >= 0, "reorder_interval must be >= 0");
   require_finite(settings.gravity, "gravity");
   s.kernels = &kernels::select_kernels(settings.simd);
@@ -838,7 +840,9 @@ double World::critical_dt() {
 std::uint64_t World::step_count() const { return state_->step; }
 double World::time() const { return state_->time; }
 void World::set_threads(int threads) {
-  require(threads >= 0, "threads must be >= 0 (0: all cores)");
+  require(threads >= 0 && threads <= kMaxThreads,
+          "set_threads: threads " + std::to_string(threads) + " outside 0.." + std::to_string(kMaxThreads) +
+              " (0: automatic)");
   state_->settings.threads = threads;
 }
 std::string World::simd_architecture() const { return state_->kernels->name; }

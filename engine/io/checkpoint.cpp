@@ -621,6 +621,8 @@ void World::save(const std::string& path) const {
 
 World World::load(const std::string& path, int threads, const std::string& simd) {
   io::h5::quiet_errors();
+  if (threads < 0 || threads > kMaxThreads)
+    throw Error("load: threads " + std::to_string(threads) + " outside 0.." + std::to_string(kMaxThreads));
   // The whole file, checked before HDF5 sees it.
   std::vector<unsigned char> bytes;
   {

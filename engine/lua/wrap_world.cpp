@@ -78,11 +78,11 @@ int world_new(lua_State* L) {
     s.dt = o.number("dt", s.dt);
     s.dt_safety = o.number("dt_safety", s.dt_safety);
     s.allow_dt_above_estimate = o.boolean("allow_dt_above_estimate", s.allow_dt_above_estimate);
-    s.dt_interval = static_cast<int>(o.integer("dt_interval", s.dt_interval));
-    s.threads = static_cast<int>(o.integer("threads", s.threads));
+    s.dt_interval = int_in(o.integer("dt_interval", s.dt_interval), "asperity.world: dt_interval", 1, 1 << 30);
+    s.threads = int_in(o.integer("threads", s.threads), "asperity.world: threads", 0, kMaxThreads);
     s.simd = o.string("simd", s.simd);
     s.track_energy = o.boolean("track_energy", s.track_energy);
-    s.reorder_interval = static_cast<int>(o.integer("reorder_interval", s.reorder_interval));
+    s.reorder_interval = int_in(o.integer("reorder_interval", s.reorder_interval), "asperity.world: reorder_interval", 0, 1 << 30);
     s.lock_bonded_rotation = o.boolean("lock_bonded_rotation", s.lock_bonded_rotation);
     o.finish();
     // Construct before setting the metatable: if the constructor throws, no __gc will ever run
@@ -564,7 +564,7 @@ int world_set_tag(lua_State* L) {
   return guarded(L, [&] {
     World& w = world_arg(L);
     std::vector<std::int64_t> ids = ids_arg(L, 2, w, "world:set_tag");
-    w.set_tag(ids, static_cast<int>(check_integer(L, 3)));
+    w.set_tag(ids, int_in(check_integer(L, 3), "world:set_tag: tag", INT32_MIN, INT32_MAX));
     return 0;
   });
 }
@@ -599,8 +599,8 @@ int world_flags(lua_State* L) {
 int world_contact_summary(lua_State* L) {
   return guarded(L, [&] {
     World& w = world_arg(L);
-    int a = static_cast<int>(check_integer(L, 2));
-    int b = static_cast<int>(check_integer(L, 3));
+    int a = int_in(check_integer(L, 2), "world:contact_summary: tag_a", INT32_MIN, INT32_MAX);
+    int b = int_in(check_integer(L, 3), "world:contact_summary: tag_b", INT32_MIN, INT32_MAX);
     lua_Integer mask = opt_integer(L, 4, 0);
     if (mask < 0 || mask > 255) throw ArgError{4, "a flag mask is 8 bits (0..255)"};
     ContactSummary c = w.contact_summary(a, b, static_cast<std::uint8_t>(mask));
@@ -675,7 +675,7 @@ int l_load(lua_State* L) {
     std::string simd = "auto";
     if (!lua_isnoneornil(L, 2)) {
       Options o(L, 2, "asperity.load", 2);
-      threads = static_cast<int>(o.integer("threads", threads));
+      threads = int_in(o.integer("threads", threads), "asperity.load: threads", 0, kMaxThreads);
       simd = o.string("simd", simd);
       o.finish();
     }
@@ -1052,7 +1052,7 @@ int world_time(lua_State* L) {
 int world_set_threads(lua_State* L) {
   return guarded(L, [&] {
     World& w = world_arg(L);
-    w.set_threads(static_cast<int>(check_integer(L, 2)));
+    w.set_threads(int_in(check_integer(L, 2), "world:set_threads: threads", 0, kMaxThreads));
     return 0;
   });
 }

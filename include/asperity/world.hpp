@@ -35,6 +35,7 @@ inline constexpr double kMaxCoordinate = 1e9;                      // m, |x|, |y
 inline constexpr double kMinStiffness = 1e-12, kMaxStiffness = 1e15;  // N/m (kn; ks may be 0)
 inline constexpr double kMinDt = 1e-15;                            // s, a fixed time step
 inline constexpr double kMinDtSafety = 1e-3;                       // dt / critical estimate
+inline constexpr int kMaxThreads = 1024;                           // OpenMP threads asked for
 
 // Contact springs and friction (model.md 4). Source values: kn = 0.1 N/m, ks = kn/10, mu = 0.5.
 struct ContactMaterial {
