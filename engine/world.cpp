@@ -792,12 +792,42 @@ const std::vector<BreakEvent>& World::break_events() const { return state_->brea
 
 // --- running -------------------------------------------------------------------------------
 
+namespace {
+// After a stopped step: the first non-finite value of the particles or groups, if any is left.
+void recheck_health(State& s) {
+  const auto& p = s.p;
+  auto bad = [](const Vec3& v) { return !std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z); };
+  synced(s);
+  for (std::size_t i = 0; i < p.n; ++i)
+    for (const Vec3& v : {Vec3{p.x[i], p.y[i], p.z[i]}, Vec3{p.vx[i], p.vy[i], p.vz[i]}, Vec3{p.wx[i], p.wy[i], p.wz[i]}})
+      if (bad(v))
+        throw HealthError("simulation unhealthy at step " + std::to_string(s.step) + ": particle " +
+                              std::to_string(p.id[i]) + " still holds the non-finite values of the step "
+                              "that stopped (set its position and velocity, or load a checkpoint)",
+                          s.step, p.id[i], "position or velocity", std::nan(""));
+  for (std::size_t g = 0; g < s.groups.size(); ++g) {
+    const auto& grp = s.groups[g];
+    if (bad(grp.centre) || bad(grp.velocity) || bad(grp.angular_velocity))
+      throw HealthError("simulation unhealthy at step " + std::to_string(s.step) + ": group " + std::to_string(g) +
+                            " still holds the non-finite values of the step that stopped",
+                        s.step, -1, "group position or velocity", std::nan(""));
+  }
+  s.unhealthy = false;
+}
+}  // namespace
+
 std::uint64_t World::cycle(std::uint64_t n) {
   State& s = *state_;
   require(s.p.n > 0, "cycle: the world has no particles");
-  for (std::uint64_t k = 0; k < n; ++k) {
-    if (s.stop_requested.exchange(false)) return k;
-    detail::step_once(s);
+  if (s.unhealthy) recheck_health(s);
+  try {
+    for (std::uint64_t k = 0; k < n; ++k) {
+      if (s.stop_requested.exchange(false)) return k;
+      detail::step_once(s);
+    }
+  } catch (const HealthError&) {
+    s.unhealthy = true;
+    throw;
   }
   return n;
 }

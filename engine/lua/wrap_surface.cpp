@@ -164,37 +164,6 @@ void push_ids(lua_State* L, const std::vector<std::int64_t>& ids) {
 
 // --- reading options ------------------------------------------------------------------------
 
-sf::Window window_named(const std::string& name, const std::string& context) {
-  if (name == "hann") return sf::Window::hann;
-  if (name == "none") return sf::Window::none;
-  throw Error(context + ": unknown window '" + name + "' (valid: hann, none)");
-}
-
-// Fields of AnalysisOptions, read from an Options table (finish() is the caller's).
-sf::AnalysisOptions read_analysis_options(Options& o) {
-  sf::AnalysisOptions a;
-  a.remove_mean_plane = o.boolean("remove_mean_plane", a.remove_mean_plane);
-  a.window = window_named(o.string("window", "hann"), o.context());
-  a.max_lag = o.number("max_lag", a.max_lag);
-  a.structure_fit_min_lag = o.number("structure_fit_min_lag", a.structure_fit_min_lag);
-  a.structure_fit_max_lag = o.number("structure_fit_max_lag", a.structure_fit_max_lag);
-  a.psd_fit_min_frequency = o.number("psd_fit_min_frequency", a.psd_fit_min_frequency);
-  a.psd_fit_max_frequency = o.number("psd_fit_max_frequency", a.psd_fit_max_frequency);
-  a.directions = static_cast<int>(o.integer("directions", a.directions));
-  a.sector_half_width = o.number("sector_half_width", a.sector_half_width);
-  a.abbott_levels = static_cast<int>(o.integer("abbott_levels", a.abbott_levels));
-  a.colatitude_bins = static_cast<int>(o.integer("colatitude_bins", a.colatitude_bins));
-  a.slope_max_steps = static_cast<int>(o.integer("slope_max_steps", a.slope_max_steps));
-  return a;
-}
-
-sf::AnalysisOptions analysis_options(lua_State* L, int index, const std::string& context, int arg) {
-  Options o(L, index, context, arg);
-  sf::AnalysisOptions a = read_analysis_options(o);
-  o.finish();
-  return a;
-}
-
 int integer_in(lua_Integer v, const char* what, lua_Integer lo, lua_Integer hi, const std::string& ctx) {
   if (v < lo || v > hi)
     throw Error(ctx + ": " + what + " " + std::to_string(v) + " outside " + std::to_string(lo) +
@@ -237,6 +206,46 @@ int index_arg(lua_State* L, int arg, lua_Integer n, const char* what) {
     throw ArgError{arg, std::string(what) + " " + std::to_string(i) + " outside 1.." + std::to_string(n)};
   return static_cast<int>(i - 1);
 }
+
+sf::Window window_named(const std::string& name, const std::string& context) {
+  if (name == "hann") return sf::Window::hann;
+  if (name == "none") return sf::Window::none;
+  throw Error(context + ": unknown window '" + name + "' (valid: hann, none)");
+}
+
+// Fields of AnalysisOptions, read from an Options table (finish() is the caller's).
+sf::AnalysisOptions read_analysis_options(Options& o) {
+  sf::AnalysisOptions a;
+  const std::string& ctx = o.context();
+  // Lengths and frequencies finite (NaN or inf would reach integer conversions); counts bounded
+  // (each is a loop count: a billion directions is a hang, not an analysis).
+  auto length = [&](const char* key, double fallback) {
+    const double v = finite_option(o, key, fallback);
+    if (v < 0) throw Error(ctx + ": option '" + key + "' must be >= 0, got " + g6(v));
+    return v;
+  };
+  a.remove_mean_plane = o.boolean("remove_mean_plane", a.remove_mean_plane);
+  a.window = window_named(o.string("window", "hann"), o.context());
+  a.max_lag = length("max_lag", a.max_lag);
+  a.structure_fit_min_lag = length("structure_fit_min_lag", a.structure_fit_min_lag);
+  a.structure_fit_max_lag = length("structure_fit_max_lag", a.structure_fit_max_lag);
+  a.psd_fit_min_frequency = length("psd_fit_min_frequency", a.psd_fit_min_frequency);
+  a.psd_fit_max_frequency = length("psd_fit_max_frequency", a.psd_fit_max_frequency);
+  a.directions = integer_in(o.integer("directions", a.directions), "directions", 1, 3600, ctx);
+  a.sector_half_width = finite_option(o, "sector_half_width", a.sector_half_width);
+  a.abbott_levels = integer_in(o.integer("abbott_levels", a.abbott_levels), "abbott_levels", 2, 1 << 20, ctx);
+  a.colatitude_bins = integer_in(o.integer("colatitude_bins", a.colatitude_bins), "colatitude_bins", 1, 1 << 20, ctx);
+  a.slope_max_steps = integer_in(o.integer("slope_max_steps", a.slope_max_steps), "slope_max_steps", 1, 1 << 20, ctx);
+  return a;
+}
+
+sf::AnalysisOptions analysis_options(lua_State* L, int index, const std::string& context, int arg) {
+  Options o(L, index, context, arg);
+  sf::AnalysisOptions a = read_analysis_options(o);
+  o.finish();
+  return a;
+}
+
 
 // Generation parameters from a table: a reference surface by name, overridden field by field,
 // or all of H (or Hx, Hy), Lc (or Lcx, Lcy) and variance.
@@ -477,7 +486,7 @@ int l_profilometer(lua_State* L) {
       std::size_t c = 1;
       for (double v : check_numbers(L, lua_gettop(L), &c)) {
         if (v != std::floor(v) || v < 1 || v > static_cast<double>(radii.size()))
-          throw Error(ctx + ": no particle " + std::to_string(v) + " in ids (valid: 1.." +
+          throw Error(ctx + ": no particle " + number_text(v) + " in ids (valid: 1.." +
                       std::to_string(radii.size()) + ")");
         subset.push_back(static_cast<std::int64_t>(v) - 1);
       }
@@ -542,9 +551,9 @@ sf::DemMeanPlane mean_plane_of(lua_State* L, const sf::HeightMap& dem, const sf:
                                int options_index, const std::string& context, int arg) {
   Options o(L, options_index, context, arg);
   sf::DemMeanPlaneOptions m;
-  m.levels = static_cast<int>(o.integer("levels", m.levels));
-  m.bandwidth = o.number("bandwidth", m.bandwidth);
-  m.tolerance = o.number("tolerance", m.tolerance);
+  m.levels = integer_in(o.integer("levels", m.levels), "levels", 2, 1 << 20, context);
+  m.bandwidth = finite_option(o, "bandwidth", m.bandwidth);
+  m.tolerance = finite_option(o, "tolerance", m.tolerance);
   o.finish();
   return sf::dem_mean_plane(dem, syn, m);
 }
@@ -618,11 +627,13 @@ int l_noise_study(lua_State* L) {
     if (o.push("levels") != LUA_TNIL) {
       std::size_t c = 1;
       levels = check_numbers(L, lua_gettop(L), &c);
+      if (levels.size() > 1000) throw Error("asperity.surface.noise_study: " + std::to_string(levels.size()) + " levels, at most 1000");
     } else {
       for (int k = 0; k <= 10; ++k) levels.push_back(0.1 * k);
     }
     lua_pop(L, 1);
     const lua_Integer seed = o.integer("seed", 1);
+    if (seed < 0) throw Error("asperity.surface.noise_study: seed must be >= 0, got " + std::to_string(seed));
     const sf::AnalysisOptions a = read_analysis_options(o);
     o.finish();
     const auto study = sf::noise_study(m, levels, static_cast<std::uint64_t>(seed), a);

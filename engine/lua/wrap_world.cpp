@@ -327,7 +327,7 @@ int world_add_mesh(lua_State* L) {
         double idx = tflat[3 * t + static_cast<std::size_t>(k)];
         if (idx != std::floor(idx) || idx < 1 || idx > static_cast<double>(vertices.size()))
           throw Error("world:add_mesh: triangle " + std::to_string(t + 1) +
-                      " refers to vertex " + std::to_string(idx) + " (vertices are 1.." +
+                      " refers to vertex " + number_text(idx) + " (vertices are 1.." +
                       std::to_string(vertices.size()) + ")");
         triangles[t][static_cast<std::size_t>(k)] = static_cast<int>(idx) - 1;
       }
@@ -524,7 +524,7 @@ std::vector<std::int64_t> ids_arg(lua_State* L, int arg, const World& w, const c
   if (v.empty()) throw ArgError{arg, "the list of particle ids is empty"};
   for (double x : v) {
     if (x != std::floor(x) || x < 1 || x > static_cast<double>(n))
-      throw ArgError{arg, "no particle " + std::to_string(x) + " (valid: 1.." + std::to_string(n) + ")"};
+      throw ArgError{arg, "no particle " + number_text(x) + " (valid: 1.." + std::to_string(n) + ")"};
     ids.push_back(static_cast<std::int64_t>(x) - 1);
   }
   return ids;

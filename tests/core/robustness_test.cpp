@@ -86,3 +86,21 @@ TEST(Robustness, ParticlesSpreadBeyondTheRangeOfDoublesStopTheStep) {
     EXPECT_NE(std::string(e.what()).find("non-finite extent"), std::string::npos);
   }
 }
+
+// After a stopped step the world keeps its non-finite values for inspection; no later cycle may
+// succeed while any are left, even where the step would not touch them (a fixed group's member).
+TEST(Robustness, NoCycleSucceedsWhileAStoppedStepsNaNIsLeft) {
+  World w = pair_of_spheres();
+  w.state().p.vx[w.state().p.index_of_id[0]] = std::nan("");
+  EXPECT_THROW(w.cycle(1), HealthError);
+  GroupMotion fixed;
+  fixed.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
+  const std::int64_t member[] = {0};
+  w.add_group(member, fixed);
+  try {
+    w.cycle(3);
+    FAIL() << "a cycle succeeded with a NaN left";
+  } catch (const HealthError& e) {
+    EXPECT_NE(std::string(e.what()).find("still holds the non-finite values"), std::string::npos) << e.what();
+  }
+}

@@ -124,6 +124,12 @@ local function new_world()
   if chance(0.1) then settings.skin = num(function() return random() * 1e-3 end) end
   if chance(0.1) then settings.threads = integer(0, 2) end
   if chance(0.05) then settings.dt_interval = integer(1, 200) end
+  if chance(0.05) then settings.reorder_interval = integer(0, 20) end
+  if chance(0.05) then settings.simd = pick{"auto", "scalar", "float", "avx9000", 3} end
+  if chance(0.05) then settings.track_energy = chance(0.5) end
+  if chance(0.05) then settings.lock_bonded_rotation = chance(0.5) end
+  if chance(0.05) then settings.allow_dt_above_estimate = chance(0.5) end
+  if chance(0.05) then settings.dt = num(function() return random() * 1e-3 end) end
   local w = asperity.world(settings)
   for _ = 1, random(0, 12) do
     w:add_particle({small(), small(), small()}, radius())
@@ -412,6 +418,32 @@ A.profilometer = function()
   if r < 0.5 then return asperity.surface.classify(p, m, chance(0.5) and {band = num(function() return 1e-3 end), shift = chance(0.5) and num(small) or nil} or nil) end
   if r < 0.7 then return asperity.surface.mean_plane(p, m, chance(0.3) and {levels = integer(1, 50)} or nil) end
   return p.surface:colatitude()
+end
+local function analysis_options()
+  if chance(0.3) then return nil end
+  local o = {}
+  for _, k in ipairs{"max_lag", "structure_fit_min_lag", "structure_fit_max_lag", "psd_fit_min_frequency",
+                     "psd_fit_max_frequency", "sector_half_width"} do
+    if chance(0.15) then o[k] = num(function() return random() * 1e-3 end) end
+  end
+  for _, k in ipairs{"directions", "abbott_levels", "colatitude_bins", "slope_max_steps"} do
+    if chance(0.15) then o[k] = integer(1, 12) end
+  end
+  if chance(0.1) then o.window = pick{"hann", "none", "kaiser"} end
+  if chance(0.1) then o.remove_mean_plane = chance(0.5) end
+  return o
+end
+A.analysis = function()
+  local m = map()
+  local r = random()
+  if r < 0.4 then return m:analyze(analysis_options()) end
+  if r < 0.7 then return m:polar(analysis_options()) end
+  if r < 0.85 then return m:psd{angle = chance(0.5) and num(small) or nil, half_width = chance(0.5) and num(small) or nil,
+                                window = chance(0.2) and pick{"hann", "x"} or nil} end
+  local o = analysis_options() or {}
+  o.seed = chance(0.8) and random(0, 5) or integer(0, 3)
+  o.levels = chance(0.5) and {num(function() return random() end), num(function() return random() end)} or nil
+  return asperity.surface.noise_study(m, o)
 end
 A.profile_analysis = function()
   local h = {}

@@ -50,6 +50,7 @@ while [ "$a" -le "$last" ]; do
     s=$a
     while [ "$s" -le "$b" ]; do
       run "$s" "$s"
+      tally
       if [ "$rc" -eq 0 ] && grep -q '^PASS' "$log"; then
         rm -f "$log"
       elif [ "$rc" -eq 137 ]; then
@@ -59,7 +60,6 @@ while [ "$a" -le "$last" ]; do
       else
         crashes=$((crashes + 1)); sequences=$((sequences + 1)); failed_seeds="$failed_seeds $s(crash)"
       fi
-      tally
       s=$((s + 1))
     done
   fi
