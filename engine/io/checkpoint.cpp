@@ -29,43 +29,9 @@ constexpr int kCheckpointVersion = 5;  // 2: servo integral and integral time, g
                                        // 4: meshes' candidates within half the skin;
                                        // 5: a header with a checksum in the HDF5 user block
 
-// The file's first kHeaderBytes are HDF5's user block (HDF5 finds its superblock after it; h5py
-// and h5dump read the file as usual). They hold kMagic, the byte count of the rest and its
-// checksum, so that a damaged file is refused before HDF5 parses it: the HDF5 library does not
-// survive every corruption of its own metadata.
-constexpr std::size_t kHeaderBytes = 512;
-constexpr char kMagic[] = "asperity checkpoint\n";  // 20 bytes, then two little-endian uint64
-constexpr unsigned char kHdf5Signature[8] = {0x89, 'H', 'D', 'F', '\r', '\n', 0x1a, '\n'};
-
-// 64-bit checksum, four interleaved lanes of 8-byte words (fast on large files). Each step
-// h -> rotl(h ^ w, 29) * odd is a bijection in w and in h, so a change of any one word always
-// changes the result; several changes go unnoticed with probability ~2^-64.
-std::uint64_t checksum(const unsigned char* data, std::size_t n) {
-  constexpr std::uint64_t kOdd = 0x9e3779b97f4a7c15ULL;
-  std::uint64_t h[4] = {0x243f6a8885a308d3ULL, 0x13198a2e03707344ULL, 0xa4093822299f31d0ULL,
-                        0x082efa98ec4e6c89ULL};
-  auto mix = [](std::uint64_t x, std::uint64_t w) { return std::rotl(x ^ w, 29) * kOdd; };
-  std::size_t i = 0;
-  for (; i + 32 <= n; i += 32)
-    for (int l = 0; l < 4; ++l) {
-      std::uint64_t w;
-      std::memcpy(&w, data + i + 8 * l, 8);
-      h[l] = mix(h[l], w);
-    }
-  for (; i < n; ++i) h[0] = mix(h[0], data[i]);
-  std::uint64_t r = n;
-  for (int l = 0; l < 4; ++l) r = mix(r, h[l]);
-  return r ^ (r >> 31);
-}
-
-void put_u64(unsigned char* at, std::uint64_t v) {
-  for (int k = 0; k < 8; ++k) at[k] = static_cast<unsigned char>(v >> (8 * k));
-}
-std::uint64_t get_u64(const unsigned char* at) {
-  std::uint64_t v = 0;
-  for (int k = 0; k < 8; ++k) v |= std::uint64_t(at[k]) << (8 * k);
-  return v;
-}
+// The file's kind in the header of its HDF5 user block (io::h5::file_image), whose checksum is
+// verified before HDF5 parses the file: HDF5 does not survive every corruption of its metadata.
+constexpr const char* kMagic = "asperity checkpoint\n";
 
 template <class T>
 hid_t native_type() {
@@ -597,24 +563,14 @@ void World::save(const std::string& path) const {
   {
     // Built in memory, then written by us: a full disk is reported here, before the rename, and
     // the previous file under `path` stays as it was (io::h5::create_file).
-    const io::h5::Handle h = io::h5::create_file(file.temp_path(), kHeaderBytes);
+    const io::h5::Handle h = io::h5::create_file(file.temp_path());
     Writer w{h, path};
     int version = kCheckpointVersion;
     w.scalar("asperity_checkpoint_version", version);
     detail::sync_lazy(const_cast<State&>(*state_));  // idle members to where they are (not observable)
     visit(w, const_cast<State&>(*state_));  // the writer only reads (and fills the fn and U columns from the records)
-    image = io::h5::file_image(h, path);
+    image = io::h5::file_image(h, path, kMagic);
   }
-  // The core driver's image may start at the superblock, without the user block (HDF5 1.10), or
-  // hold the user block too: either way the file is the header and then the superblock.
-  if (image.size() >= 8 && std::memcmp(image.data(), kHdf5Signature, 8) == 0)
-    image.insert(image.begin(), kHeaderBytes, 0);
-  if (image.size() < kHeaderBytes + 8 || std::memcmp(image.data() + kHeaderBytes, kHdf5Signature, 8) != 0)
-    throw Error("cannot write checkpoint '" + path + "': unexpected HDF5 file image");
-  std::memset(image.data(), 0, kHeaderBytes);
-  std::memcpy(image.data(), kMagic, sizeof kMagic - 1);
-  put_u64(image.data() + 24, image.size() - kHeaderBytes);
-  put_u64(image.data() + 32, checksum(image.data() + kHeaderBytes, image.size() - kHeaderBytes));
   io::write_bytes(file.temp_path(), image, path, true);
   file.commit();
 }
@@ -623,34 +579,11 @@ World World::load(const std::string& path, int threads, const std::string& simd)
   io::h5::quiet_errors();
   if (threads < 0 || threads > kMaxThreads)
     throw Error("load: threads " + std::to_string(threads) + " outside 0.." + std::to_string(kMaxThreads));
-  // The whole file, checked before HDF5 sees it.
-  std::vector<unsigned char> bytes;
-  {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error("cannot read checkpoint '" + path + "': no such file or not readable");
-    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    if (in.bad()) throw Error("cannot read checkpoint '" + path + "': read error");
-  }
-  const bool legacy = bytes.size() >= 8 && std::memcmp(bytes.data(), kHdf5Signature, 8) == 0;
-  if (!legacy) {
-    if (bytes.size() < kHeaderBytes || std::memcmp(bytes.data(), kMagic, sizeof kMagic - 1) != 0)
-      throw Error("cannot read checkpoint '" + path + "': not an HDF5 file with an asperity checkpoint header");
-    const std::uint64_t size = get_u64(bytes.data() + 24), sum = get_u64(bytes.data() + 32);
-    if (size != bytes.size() - kHeaderBytes)
-      throw Error("checkpoint '" + path + "' is truncated or damaged: " + std::to_string(bytes.size()) +
-                  " bytes, the header says " + std::to_string(size + kHeaderBytes));
-    if (sum != checksum(bytes.data() + kHeaderBytes, bytes.size() - kHeaderBytes))
-      throw Error("checkpoint '" + path + "' is damaged: its checksum does not match its contents");
-  }
-  // Opened from the bytes already read (the file on disk may change meanwhile).
-  io::h5::Handle access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
-  if (H5Pset_fapl_core(access, 1 << 20, 0) < 0 || H5Pset_file_image(access, bytes.data(), bytes.size()) < 0)
-    throw Error("cannot read checkpoint '" + path + "': cannot set up an in-memory file");
-  // The core driver refuses a name that exists on disk when it opens an image; `path` is a file,
-  // so nothing can exist below it.
-  const std::string image_name = path + "/(in memory)";
-  io::h5::Handle h(H5Fopen(image_name.c_str(), H5F_ACC_RDONLY, access), H5Fclose);
-  if (!h.valid()) throw Error("cannot read checkpoint '" + path + "': not an HDF5 file");
+  // The whole file, checked before HDF5 sees it (older checkpoints have no header: HDF5 and the
+  // checks after loading are all they get), then opened from the bytes read.
+  bool had_header = false;
+  std::vector<unsigned char> bytes = io::h5::read_checked(path, kMagic, &had_header);
+  io::h5::Handle h = io::h5::open_image(bytes, path);
   bytes = {};
   Reader r{h, path};
   int version = 0;
@@ -658,7 +591,7 @@ World World::load(const std::string& path, int threads, const std::string& simd)
   if (version < 1 || version > kCheckpointVersion)
     throw Error("checkpoint '" + path + "' has version " + std::to_string(version) +
                 ", this build reads versions 1 to " + std::to_string(kCheckpointVersion));
-  if (version >= 5 && legacy) throw Error("checkpoint '" + path + "' is damaged: its header is missing");
+  if (version >= 5 && !had_header) throw Error("checkpoint '" + path + "' is damaged: its header is missing");
   r.version = version;
   World world;
   State& s = world.state();

@@ -77,6 +77,17 @@ void write_bytes(const fs::path& temp, std::span<const unsigned char> bytes, con
   if (::close(fd) != 0) throw failed("close", errno);
 }
 
+bool is_complete_png(const fs::path& path) {
+  static constexpr unsigned char kEnd[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  unsigned char tail[12] = {};
+  const bool ok = std::fseek(f, -12, SEEK_END) == 0 && std::fread(tail, 1, 12, f) == 12 &&
+                  std::memcmp(tail, kEnd, 12) == 0;
+  std::fclose(f);
+  return ok;
+}
+
 void write_text_file(const fs::path& path, std::string_view contents) {
   AtomicFile file(path);
   write_bytes(file.temp_path(),

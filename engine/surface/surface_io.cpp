@@ -194,9 +194,9 @@ void save_hdf5(const HeightMap& map, const std::string& path) {
 
 HeightMap load_hdf5(const std::string& path, double spacing_override) {
     if (!std::filesystem::exists(path)) throw Error("load_hdf5: no file " + path);
-    if (H5Fis_hdf5(path.c_str()) <= 0)
-        throw Error("load_hdf5: " + path + " is not an HDF5 file");
-    Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose, "opening " + path);
+    // Read whole and its header checked first (io::h5::read_checked): HDF5 does not survive every
+    // damaged file.
+    const io::h5::Handle file = io::h5::open_file_read(path);
     if (H5Lexists(file, "height", H5P_DEFAULT) <= 0)
         throw Error("load_hdf5: " + path + " has no dataset 'height'");
     Handle dset(H5Dopen2(file, "height", H5P_DEFAULT), H5Dclose, "opening dataset height");

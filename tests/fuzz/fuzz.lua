@@ -297,6 +297,17 @@ W.reentrant = function(w)
 end
 W.read_back = function(w)
   local p = out .. "/f" .. random(1, 6) .. ".h5"
+  if chance(0.5) then  -- a damaged copy of a file written before (surface, series, snapshot, checkpoint)
+    local f = io.open(p, "rb")
+    if f then
+      local bytes = f:read("a")
+      f:close()
+      p = out .. "/damaged_read.h5"
+      local g = assert(io.open(p, "wb"))
+      g:write(corrupt(bytes))
+      g:close()
+    end
+  end
   local r = random()
   if r < 0.3 then return asperity.h5_datasets(p) end
   if r < 0.6 then return asperity.read_h5(p, pick{"particles/x", "height", "x", "/", "", "settings/gravity"}) end

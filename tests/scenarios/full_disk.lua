@@ -46,6 +46,14 @@ local m = asperity.surface.generate{name = "S5", n = 513, seed = 1}
 refuses("cannot write '.*surface.h5'", m.save, m, out .. "/surface.h5")
 refuses("cannot write '.*surface.csv'", m.save_csv, m, out .. "/surface.csv")
 
+-- Plots (gnuplot writes the PNG; an image cut short is an error, not a file), when gnuplot is here.
+if os.execute("command -v gnuplot >/dev/null 2>&1") then
+  local x = {}
+  for i = 1, 100000 do x[i] = i end
+  refuses("plot", asperity.plot, {file = out .. "/plot.png", x = x, y = x, points = true,
+                                                width = 4000, height = 4000})
+end
+
 -- The small world can still be written (the failures left nothing open behind them).
 small:save(out .. "/again.h5")
 assert(asperity.load(out .. "/again.h5"):particle_count() == 2)

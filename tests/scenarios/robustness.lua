@@ -160,8 +160,20 @@ end
 write(bad, bytes:sub(1, #bytes // 2))
 refuses("truncated or damaged", asperity.load, bad)
 write(bad, "not a checkpoint at all")
-refuses("not an HDF5 file with an asperity checkpoint header", asperity.load, bad)
-refuses("no such file", asperity.load, P.out .. "/missing.h5")
+refuses("not an HDF5 file with a header 'asperity checkpoint'", asperity.load, bad)
+refuses("does not exist", asperity.load, P.out .. "/missing.h5")
+
+-- Any HDF5 file written here carries the checksum: a damaged surface or series file is refused
+-- before HDF5 reads it (HDF5 itself crashed on some damaged files).
+m:save(P.out .. "/surface.h5")
+f = assert(io.open(P.out .. "/surface.h5", "rb"))
+bytes = f:read("a")
+f:close()
+write(bad, bytes:sub(1, 700) .. string.char((bytes:byte(701) + 1) % 256) .. bytes:sub(702))
+refuses("checksum does not match", asperity.surface.load, bad)
+refuses("checksum does not match", asperity.read_h5, bad, "height")
+refuses("checksum does not match", asperity.h5_datasets, bad)
+assert(asperity.surface.load(P.out .. "/surface.h5"):spacing() == m:spacing())
 
 -- A failed write raises and leaves the previous file as it was (an unwritable directory).
 refuses("does not exist", w.save, w, P.out .. "/no/such/dir/x.h5")
