@@ -441,7 +441,14 @@ void step_once(State& s) {
       run_stages_serially({&g.servo, &g.motion, &g.moves});
     }
   }
-  for (auto& w : s.walls.walls) w.displacement += w.velocity * s.dt;
+  for (auto& w : s.walls.walls) {
+    w.displacement += w.velocity * s.dt;
+    // A prescribed velocity near the largest double overflows here; nothing else would see it
+    // until a particle touched the wall.
+    if (!std::isfinite(w.displacement.x + w.displacement.y + w.displacement.z))
+      health_error(s, "non-finite wall displacement (wall velocity too large)", -1, "wall displacement",
+                   norm(w.displacement));
+  }
   ++s.step;
   s.time += s.dt;
   bookkeep(s);

@@ -1180,7 +1180,8 @@ void open_world(lua_State* L) {
   static const Function methods[] = {
       // particles
       {"add_particle", world_add_particle, "world:add_particle(pos, radius [, density]) -> id",
-       "Adds a sphere at pos {x, y, z}; density defaults to the world's. Ids count from 1."},
+       "Adds a sphere at pos {x, y, z}; density defaults to the world's. Ids count from 1.\n"
+       "Accepted: radius 1e-6..1e3 m, density 1e-6..1e9 kg/m^3, |x|, |y|, |z| <= 1e9 m."},
       {"add_particles", world_add_particles,
        "world:add_particles(positions, radii [, density]) -> first_id, last_id",
        "Adds many spheres at once: positions an n x 3 Array or {{x,y,z}, ...}; radii an Array,\n"
@@ -1313,7 +1314,7 @@ void open_world(lua_State* L) {
       {"dt", world_dt, "world:dt() -> s", "The time step in use."},
       {"set_dt", set_world_number<&World::set_dt>, "world:set_dt(dt)", "Fixes the time step (0: automatic again)."},
       {"set_dt_safety", set_world_number<&World::set_dt_safety>, "world:set_dt_safety(f)",
-       "Automatic time step = f x the critical estimate (default 0.8; 0 < f <= 2)."},
+       "Automatic time step = f x the critical estimate (default 0.8; 0.001 <= f <= 2)."},
       {"set_skin", set_world_number<&World::set_skin>, "world:set_skin(m)", "Verlet skin in m (the list is rebuilt)."},
       {"set_friction", set_world_number<&World::set_friction>, "world:set_friction(mu)",
        "Ball-ball Coulomb coefficient from the next step on (walls keep theirs)."},

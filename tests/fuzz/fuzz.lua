@@ -486,6 +486,10 @@ local function world_problem(w)
       if not (finite(v[1]) and finite(v[2]) and finite(v[3])) then return "group " .. g end
     end
   end
+  for k = 1, w:wall_count() do
+    local d = w:wall_displacement(k)
+    if not (finite(d[1]) and finite(d[2]) and finite(d[3])) then return "wall " .. k .. " displacement" end
+  end
   if not (finite(w:time()) and finite(w:dt())) then return "time or dt" end
 end
 
