@@ -378,11 +378,15 @@ std::vector<double> World::radii() const { return by_id(*state_, state_->p.radiu
 int World::add_plane(Vec3 point, Vec3 normal, ContactMaterial material) {
   require_position(point, "add_plane: point");
   require_finite(normal, "add_plane: normal");
-  // Scaled by its largest component first: |n|^2 of {0, 0, 1e200} would overflow to infinity.
   const double big = std::max({std::fabs(normal.x), std::fabs(normal.y), std::fabs(normal.z)});
   require(big > 0, "add_plane: normal must be non-zero, got " + vec_text(normal));
-  normal = normal / big;
-  const double len = norm(normal);
+  double len = norm(normal);
+  if (!(len > 0 && std::isfinite(len))) {
+    // |n|^2 of {0, 0, 1e200} overflows (of {1e-200, 0, 0} underflows): scaled by its largest
+    // component first. Only then, so that every other normal comes out bit for bit as before.
+    normal = normal / big;
+    len = norm(normal);
+  }
   check_material(material, "plane material");
   detail::Wall w;
   w.kind = detail::Wall::Kind::plane;
