@@ -338,7 +338,7 @@ int l_load(lua_State* L) {
   return guarded(L, [&] {
     const std::string path = check_string(L, 1);
     Options o(L, 2, "asperity.surface.load", 2);
-    const double spacing = o.number("spacing", 0.0);
+    const double spacing = finite_option(o, "spacing", 0.0);
     o.finish();
     push_map(L, sf::load_hdf5(path, spacing));
     return 1;
@@ -350,8 +350,8 @@ int l_load_grid(lua_State* L) {
     const std::string path = check_string(L, 1);
     Options o(L, 2, "asperity.surface.load_grid", 2);
     sf::GridImportOptions g;
-    g.spacing = o.number("spacing", g.spacing);
-    g.height_scale = o.number("height_scale", g.height_scale);
+    g.spacing = finite_option(o, "spacing", g.spacing);
+    g.height_scale = finite_option(o, "height_scale", g.height_scale);
     o.finish();
     push_map(L, sf::load_grid(path, g));
     return 1;
@@ -370,7 +370,8 @@ int l_height_map(lua_State* L) {
     std::vector<double> h = check_numbers(L, lua_gettop(L), &cols);
     lua_pop(L, 1);
     o.finish();
-    if (!(spacing > 0)) throw Error("asperity.surface.height_map: give spacing = grid step (m) > 0");
+    if (!(spacing > 0) || !std::isfinite(spacing))
+      throw Error("asperity.surface.height_map: give spacing = grid step (m), finite and > 0, got " + g6(spacing));
     const std::size_t nx = cols > 1 ? cols : static_cast<std::size_t>(nx_given);
     if (nx < 1 || h.empty() || h.size() % nx != 0)
       throw Error("asperity.surface.height_map: " + std::to_string(h.size()) +

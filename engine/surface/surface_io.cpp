@@ -220,7 +220,8 @@ HeightMap load_hdf5(const std::string& path, double spacing_override) {
         throw Error("load_hdf5: " + path +
                                  ": dataset 'height' has no 'spacing' attribute; pass the spacing "
                                  "(m) to load_hdf5");
-    if (!(map.spacing > 0)) throw Error("load_hdf5: " + path + ": spacing must be > 0");
+    if (!(map.spacing > 0) || !std::isfinite(map.spacing))
+        throw Error("load_hdf5: " + path + ": spacing must be finite and > 0");
 
     if (has_attribute(dset, "hurst_x")) {
         SurfaceParams p;
@@ -362,7 +363,7 @@ HeightMap load_grid(const std::string& path, const GridImportOptions& options) {
     if (options.height_scale != 1.0)
         for (double& z : map.height) z *= options.height_scale;
     map.spacing = options.spacing > 0 ? options.spacing : file_spacing;
-    if (!(map.spacing > 0))
+    if (!(map.spacing > 0) || !std::isfinite(map.spacing))
         throw Error("load_grid: " + path +
                                  " gives no spacing ('# spacing = <m>' or ESRI cellsize); set "
                                  "GridImportOptions.spacing");

@@ -119,6 +119,19 @@ refuses("column 34 outside", m.column, m, 34)
 local row = m:row(33)
 assert(#row == 33)
 
+-- A map whose spacing is not finite: refused where it is made (its steps once became NaN grid
+-- coordinates, read as indices).
+refuses("spacing = grid step %(m%), finite and > 0, got inf", asperity.surface.height_map,
+        {heights = {0, 0, 0, 0}, spacing = math.huge, nx = 2})
+m:save(P.out .. "/spacing.h5")
+refuses("option 'spacing' must be finite", asperity.surface.load, P.out .. "/spacing.h5", {spacing = math.huge})
+
+-- A profile across a map one node wide (its interpolation once read outside the map).
+local strip = asperity.surface.height_map{heights = {0, 1e-4, 2e-4}, spacing = 1e-3, nx = 1}
+local along = strip:profile(0, 0, math.pi / 2)
+assert(#along == 3 and along[2] == 1e-4)
+assert(#strip:profile(0, 0.0005, 0.3) >= 1)
+
 -- The profilometer: origin must be finite; its NaN nodes do not crash colatitude (a realistic
 -- call with default arguments).
 local dem = asperity.world{}
