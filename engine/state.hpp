@@ -163,6 +163,10 @@ struct State {
 
   double skin = 0;
   bool need_rebuild = true;
+  // A step stopped by the health check left non-finite values behind (kept for inspection): the
+  // next cycle looks for them before it steps (World::cycle), so that no later cycle can succeed
+  // while, e.g., a fixed group's member still holds a NaN the step does not touch.
+  bool unhealthy = false;
   bool force_reorder = false;
   std::uint64_t rebuilds = 0, reorders = 0, rebuilds_since_reorder = 0;
 

@@ -37,6 +37,11 @@ void check_dt(State& s) {
   s.last_estimate_step = s.step;
   if (!s.dt_fixed) {
     s.dt = s.settings.dt_safety * s.dt_estimate;
+    // The bounds of World's setters keep masses and stiffnesses such that this cannot happen;
+    // a step of zero or infinite length would report success while nothing (or NaN) advanced.
+    if (!(s.dt > 0 && std::isfinite(s.dt)))
+      health_error(s, "the automatic time step is not a positive finite number (critical estimate " +
+                          std::to_string(s.dt_estimate) + " s)", -1, "dt", s.dt);
   } else if (s.dt > s.dt_estimate && !s.settings.allow_dt_above_estimate) {
     std::ostringstream m;
     m << "time step " << s.dt << " s is above the critical estimate " << s.dt_estimate
@@ -117,6 +122,22 @@ void bookkeep(State& s) {
   }
   if (worst_i >= 0 && !std::isfinite(worst))
     health_error(s, "non-finite velocity or position", worst_i, "velocity", worst);
+  // The step's kinetic energy sums m v^2 and I w^2 of every particle that moves or spins: one test
+  // of the sum catches a non-finite angular velocity (or mass, or inertia), which the displacement
+  // check above does not see. Only on failure are the particles searched for the culprit.
+  if (!std::isfinite(s.kinetic_at_step)) {
+    std::int64_t culprit = -1;
+    double value = s.kinetic_at_step;
+    for (std::size_t i = 0; i < p.n && culprit < 0; ++i)
+      for (double v : {p.wx[i], p.wy[i], p.wz[i], p.vx[i], p.vy[i], p.vz[i], p.inertia[i], p.mass[i]})
+        if (!std::isfinite(v)) {
+          culprit = std::int64_t(i);
+          value = v;
+          break;
+        }
+    health_error(s, "non-finite kinetic energy (velocity, angular velocity, mass or inertia)",
+                 culprit, "kinetic energy", value);
+  }
   if (worst > 1.0)
     health_error(s, "a particle moved more than its radius (or turned more than 0.1 rad) in one "
                     "step: contacts are not resolved (time step too large, loading too fast, or "
@@ -420,7 +441,14 @@ void step_once(State& s) {
       run_stages_serially({&g.servo, &g.motion, &g.moves});
     }
   }
-  for (auto& w : s.walls.walls) w.displacement += w.velocity * s.dt;
+  for (auto& w : s.walls.walls) {
+    w.displacement += w.velocity * s.dt;
+    // A prescribed velocity near the largest double overflows here; nothing else would see it
+    // until a particle touched the wall.
+    if (!std::isfinite(w.displacement.x + w.displacement.y + w.displacement.z))
+      health_error(s, "non-finite wall displacement (wall velocity too large)", -1, "wall displacement",
+                   norm(w.displacement));
+  }
   ++s.step;
   s.time += s.dt;
   bookkeep(s);

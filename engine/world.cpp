@@ -24,20 +24,48 @@ void require(bool ok, const std::string& message) {
 }
 
 std::string num(double v) {
+  if (std::isnan(v)) return "nan";  // not "-nan": the sign of a NaN means nothing to a user
   std::ostringstream s;
   s << v;
   return s.str();
 }
 
+std::string vec_text(const Vec3& v) {
+  return "(" + num(v.x) + ", " + num(v.y) + ", " + num(v.z) + ")";
+}
+
 void require_finite(const Vec3& v, const char* what) {
   require(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z),
-          std::string(what) + " must be finite, got (" + num(v.x) + ", " + num(v.y) + ", " +
-              num(v.z) + ")");
+          std::string(what) + " must be finite, got " + vec_text(v));
+}
+
+// Positions (particles, plane points, mesh vertices) within kMaxCoordinate of the origin: the
+// cell grids take differences of coordinates, which must not overflow.
+void require_position(const Vec3& v, const char* what) {
+  require_finite(v, what);
+  require(std::fabs(v.x) <= kMaxCoordinate && std::fabs(v.y) <= kMaxCoordinate &&
+              std::fabs(v.z) <= kMaxCoordinate,
+          std::string(what) + " " + vec_text(v) + " outside [-" + num(kMaxCoordinate) + ", " +
+              num(kMaxCoordinate) + "] m on some axis");
+}
+
+void require_radius(double r, const std::string& what) {
+  require(r >= kMinRadius && r <= kMaxRadius,
+          what + " " + num(r) + " outside [" + num(kMinRadius) + ", " + num(kMaxRadius) + "] m");
+}
+
+void require_density(double rho, const std::string& what) {
+  require(rho >= kMinDensity && rho <= kMaxDensity,
+          what + " " + num(rho) + " outside [" + num(kMinDensity) + ", " + num(kMaxDensity) +
+              "] kg/m^3");
 }
 
 void check_material(const ContactMaterial& m, const char* where) {
-  require(m.kn > 0 && std::isfinite(m.kn), std::string(where) + ": kn must be > 0, got " + num(m.kn));
-  require(m.ks >= 0 && std::isfinite(m.ks), std::string(where) + ": ks must be >= 0, got " + num(m.ks));
+  require(m.kn >= kMinStiffness && m.kn <= kMaxStiffness,
+          std::string(where) + ": kn " + num(m.kn) + " outside [" + num(kMinStiffness) + ", " +
+              num(kMaxStiffness) + "] N/m");
+  require(m.ks >= 0 && m.ks <= kMaxStiffness,
+          std::string(where) + ": ks " + num(m.ks) + " outside [0, " + num(kMaxStiffness) + "] N/m");
   require(m.friction >= 0 && std::isfinite(m.friction),
           std::string(where) + ": friction must be >= 0, got " + num(m.friction));
 }
@@ -97,15 +125,19 @@ double Energies::balance_error(const Energies& initial) const {
 World::World(WorldSettings settings) : state_(std::make_unique<State>()) {
   State& s = *state_;
   check_material(settings.contact, "contact material");
-  require(settings.density > 0, "density must be > 0, got " + num(settings.density));
+  require_density(settings.density, "density");
   require(settings.local_damping >= 0 && settings.local_damping < 1,
           "local_damping must be in [0, 1), got " + num(settings.local_damping));
-  require(settings.skin >= 0, "skin must be >= 0 (0: automatic), got " + num(settings.skin));
-  require(settings.dt >= 0, "dt must be >= 0 (0: automatic), got " + num(settings.dt));
-  require(settings.dt_safety > 0 && settings.dt_safety <= 1,
-          "dt_safety must be in (0, 1], got " + num(settings.dt_safety));
+  require(settings.skin >= 0 && settings.skin <= kMaxCoordinate,
+          "skin must be >= 0 (0: automatic) and finite, got " + num(settings.skin));
+  require(settings.dt == 0 || (settings.dt >= kMinDt && std::isfinite(settings.dt)),
+          "dt " + num(settings.dt) + " must be 0 (automatic) or in [" + num(kMinDt) + ", inf) s");
+  require(settings.dt_safety >= kMinDtSafety && settings.dt_safety <= 1,
+          "dt_safety " + num(settings.dt_safety) + " outside [" + num(kMinDtSafety) + ", 1]");
   require(settings.dt_interval >= 1, "dt_interval must be >= 1");
-  require(settings.threads >= 0, "threads must be >= 0 (0: all cores)");
+  require(settings.threads >= 0 && settings.threads <= kMaxThreads,
+          "threads " + std::to_string(settings.threads) + " outside 0.." + std::to_string(kMaxThreads) +
+              " (0: automatic)");
   require(settings.reorder_interval >= 0, "reorder_interval must be >= 0");
   require(settings.rotation_lock_bonds >= 1,
           "rotation_lock_bonds must be >= 1, got " + std::to_string(settings.rotation_lock_bonds));
@@ -165,12 +197,14 @@ std::int64_t World::add_particles(std::span<const double> xyz, std::span<const d
   require(xyz.size() == 3 * radii.size(), "add_particles: " + std::to_string(xyz.size()) +
                                               " coordinates for " + std::to_string(radii.size()) +
                                               " radii (expected 3 per particle)");
-  const double rho = density > 0 ? density : s.settings.density;
-  require(std::isfinite(rho), "density must be finite");
+  // density <= 0 means the default; NaN is not "<= 0" and is refused with the rest.
+  const double rho = density <= 0 ? s.settings.density : density;
+  require_density(rho, "add_particle: density");
   for (std::size_t k = 0; k < radii.size(); ++k) {
-    require(radii[k] > 0 && std::isfinite(radii[k]),
-            "radius of particle " + std::to_string(k) + " must be > 0, got " + num(radii[k]));
-    require_finite({xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]}, "particle position");
+    const std::string which = radii.size() > 1 ? " of particle " + std::to_string(k + 1) : "";
+    require_radius(radii[k], "add_particle: radius" + which);
+    require_position({xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]},
+                     ("add_particle: position" + which).c_str());
   }
   auto& p = s.p;
   const std::size_t first = p.n;
@@ -237,7 +271,7 @@ double World::mass(std::int64_t id) const { return state_->p.mass[index_of(*stat
 int World::group_of(std::int64_t id) const { return state_->p.group[index_of(*state_, id)]; }
 
 void World::set_position(std::int64_t id, Vec3 x) {
-  require_finite(x, "position");
+  require_position(x, "set_position: position");
   auto& p = state_->p;
   const auto i = index_of(*state_, id);
   require(p.group[i] < 0, "particle " + std::to_string(id) + " belongs to group " +
@@ -273,7 +307,7 @@ void World::set_angular_velocity(std::int64_t id, Vec3 w) {
   state_->spin_known = false;
 }
 void World::set_radius(std::int64_t id, double r) {
-  require(r > 0 && std::isfinite(r), "radius must be > 0, got " + num(r));
+  require_radius(r, "set_radius: radius");
   auto& p = state_->p;
   const auto i = index_of(*state_, id);
   p.radius[i] = r;
@@ -284,6 +318,10 @@ void World::set_radius(std::int64_t id, double r) {
 void World::scale_radii(double factor) {
   require(factor > 0 && std::isfinite(factor), "scale_radii: factor must be > 0, got " + num(factor));
   auto& p = state_->p;
+  // Every new radius within bounds before any changes (a failed call leaves the world as it was).
+  for (std::size_t i = 0; i < p.n; ++i)
+    require_radius(p.radius[i] * factor, "scale_radii: factor " + num(factor) + " makes the radius of particle " +
+                                             std::to_string(p.id[i] + 1));
   for (std::size_t i = 0; i < p.n; ++i) {
     p.radius[i] *= factor;
     set_mass(p, i);
@@ -340,10 +378,17 @@ std::vector<double> World::radii() const { return by_id(*state_, state_->p.radiu
 // --- walls ---------------------------------------------------------------------------------
 
 int World::add_plane(Vec3 point, Vec3 normal, ContactMaterial material) {
-  require_finite(point, "plane point");
-  require_finite(normal, "plane normal");
-  const double len = norm(normal);
-  require(len > 0, "plane normal must be non-zero");
+  require_position(point, "add_plane: point");
+  require_finite(normal, "add_plane: normal");
+  const double big = std::max({std::fabs(normal.x), std::fabs(normal.y), std::fabs(normal.z)});
+  require(big > 0, "add_plane: normal must be non-zero, got " + vec_text(normal));
+  double len = norm(normal);
+  if (!(len > 0 && std::isfinite(len))) {
+    // |n|^2 of {0, 0, 1e200} overflows (of {1e-200, 0, 0} underflows): scaled by its largest
+    // component first. Only then, so that every other normal comes out bit for bit as before.
+    normal = normal / big;
+    len = norm(normal);
+  }
   check_material(material, "plane material");
   detail::Wall w;
   w.kind = detail::Wall::Kind::plane;
@@ -359,7 +404,7 @@ int World::add_mesh(std::span<const Vec3> vertices, std::span<const std::array<i
                     ContactMaterial material) {
   check_material(material, "mesh material");
   require(!triangles.empty(), "add_mesh: no triangles");
-  for (const auto& v : vertices) require_finite(v, "mesh vertex");
+  for (const auto& v : vertices) require_position(v, "add_mesh: vertex");
   detail::Mesh mesh;
   mesh.vertices.assign(vertices.begin(), vertices.end());
   mesh.triangles.assign(triangles.begin(), triangles.end());
@@ -369,6 +414,14 @@ int World::add_mesh(std::span<const Vec3> vertices, std::span<const std::array<i
       require(triangles[t][k] >= 0 && triangles[t][k] < nv,
               "add_mesh: triangle " + std::to_string(t) + " refers to vertex " +
                   std::to_string(triangles[t][k]) + " (vertices: 0.." + std::to_string(nv - 1) + ")");
+  // A triangle without area has no normal: the contact kernel would divide by zero.
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const Vec3 &a = vertices[triangles[t][0]], &b = vertices[triangles[t][1]], &c = vertices[triangles[t][2]];
+    const Vec3 u = b - a, v = c - a;
+    const double scale = std::max({norm(u), norm(v), norm(c - b)});
+    require(scale > 0 && norm(cross(u, v)) > 1e-12 * scale * scale,
+            "add_mesh: triangle " + std::to_string(t) + " is degenerate (its corners are on one line)");
+  }
   // Ownership of shared edges and vertices: the lowest-numbered triangle owns them.
   std::map<std::pair<int, int>, int> edge_owner;
   std::vector<int> vertex_owner(vertices.size(), -1);
@@ -428,9 +481,46 @@ std::size_t World::wall_count() const { return state_->walls.walls.size(); }
 
 // --- groups --------------------------------------------------------------------------------
 
+namespace {
+// Every check of set_group_motion, so that add_group can make them before it changes anything.
+void check_motion(const State& s, const GroupMotion& motion, bool has_inert, const std::string& who) {
+  const std::string at = who + ": ";
+  require_finite(motion.velocity, (at + "group velocity").c_str());
+  require_finite(motion.angular_velocity, (at + "group angular velocity").c_str());
+  auto valid = [](Dof d) { return d == Dof::free || d == Dof::fixed || d == Dof::velocity || d == Dof::servo; };
+  for (int k = 0; k < 3; ++k) require(valid(motion.translation[k]), at + "unknown translation mode");
+  require(valid(motion.rotation), at + "unknown rotation mode");
+  require(s.settings.rotation || motion.rotation == Dof::fixed,
+          at + "group rotation needs a world with rotation enabled");
+  require(motion.rotation != Dof::servo, at + "rotation cannot be servo-controlled (translation only)");
+  require(!has_inert || motion.rotation == Dof::fixed,
+          at + "the group has inert members: its rotation must stay fixed");
+  const char* axis[3] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k) {
+    if (motion.translation[k] != Dof::servo) continue;
+    const Servo& sv = motion.servo[k];
+    const std::string where = at + "servo on " + axis[k] + ": ";
+    require(std::isfinite(sv.target_force), where + "target_force must be finite, got " + num(sv.target_force));
+    require(std::isfinite(sv.stiffness) && sv.stiffness >= 0,
+            where + "stiffness must be >= 0 (N/m), got " + num(sv.stiffness));
+    require(std::isfinite(sv.gain) && sv.gain >= 0, where + "gain must be >= 0 (0: automatic), got " + num(sv.gain));
+    require(sv.relaxation > 0 && sv.relaxation <= 1, where + "relaxation must be in (0, 1], got " + num(sv.relaxation));
+    require(sv.max_velocity > 0 && std::isfinite(sv.max_velocity),
+            where + "max_velocity must be > 0 (m/s), got " + num(sv.max_velocity));
+    require(std::isfinite(sv.integral_time) && sv.integral_time >= 0,
+            where + "integral_time must be >= 0 (s; 0: proportional only), got " + num(sv.integral_time));
+  }
+  require(std::isfinite(motion.damping) && motion.damping < 1,
+          at + "group damping must be below 1 (a negative value: the world's local damping), got " +
+              num(motion.damping));
+}
+}  // namespace
+
 int World::add_group(std::span<const std::int64_t> ids, GroupMotion motion) {
   State& s = *state_;
   require(!ids.empty(), "add_group: no particles given");
+  // Everything is checked before the world changes: a failed call leaves no half-made group.
+  check_motion(s, motion, false, "add_group");
   const int g = int(s.groups.size());
   detail::Group grp;
   for (auto id : ids) {
@@ -452,29 +542,8 @@ int World::add_group(std::span<const std::int64_t> ids, GroupMotion motion) {
 }
 
 void World::set_group_motion(int group, const GroupMotion& motion) {
-  require_finite(motion.velocity, "group velocity");
-  require_finite(motion.angular_velocity, "group angular velocity");
-  require(state_->settings.rotation || motion.rotation == Dof::fixed,
-          "group rotation needs a world with rotation enabled");
-  require(motion.rotation != Dof::servo, "rotation cannot be servo-controlled (translation only)");
   auto& g = state_->groups[check_group(*state_, group)];
-  require(g.inert.empty() || motion.rotation == Dof::fixed,
-          "group " + std::to_string(group) + " has inert members: its rotation must stay fixed");
-  const char* axis[3] = {"x", "y", "z"};
-  for (int k = 0; k < 3; ++k) {
-    if (motion.translation[k] != Dof::servo) continue;
-    const Servo& sv = motion.servo[k];
-    const std::string where = std::string("servo on ") + axis[k] + ": ";
-    require(std::isfinite(sv.target_force), where + "target_force must be finite");
-    require(std::isfinite(sv.stiffness) && sv.stiffness >= 0, where + "stiffness must be >= 0 (N/m)");
-    require(std::isfinite(sv.gain) && sv.gain >= 0, where + "gain must be >= 0 (0: automatic)");
-    require(sv.relaxation > 0 && sv.relaxation <= 1, where + "relaxation must be in (0, 1]");
-    require(sv.max_velocity > 0 && std::isfinite(sv.max_velocity), where + "max_velocity must be > 0 (m/s)");
-    require(std::isfinite(sv.integral_time) && sv.integral_time >= 0,
-            where + "integral_time must be >= 0 (s; 0: proportional only)");
-  }
-  require(std::isfinite(motion.damping) && motion.damping < 1,
-          "group damping must be below 1 (a negative value: the world's local damping)");
+  check_motion(*state_, motion, !g.inert.empty(), "set_group_motion");
   // An axis whose servo stays as it was (same target, stiffness and integral time; e.g. only the
   // shear velocity of another axis changes) keeps its CNS origin and its integral: a reset would
   // kick the platen at every change of the other axes.
@@ -751,26 +820,58 @@ const std::vector<BreakEvent>& World::break_events() const { return state_->brea
 
 // --- running -------------------------------------------------------------------------------
 
+namespace {
+// After a stopped step: the first non-finite value of the particles or groups, if any is left.
+void recheck_health(State& s) {
+  const auto& p = s.p;
+  auto bad = [](const Vec3& v) { return !std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z); };
+  synced(s);
+  for (std::size_t i = 0; i < p.n; ++i)
+    for (const Vec3& v : {Vec3{p.x[i], p.y[i], p.z[i]}, Vec3{p.vx[i], p.vy[i], p.vz[i]}, Vec3{p.wx[i], p.wy[i], p.wz[i]}})
+      if (bad(v))
+        throw HealthError("simulation unhealthy at step " + std::to_string(s.step) + ": particle " +
+                              std::to_string(p.id[i]) + " still holds the non-finite values of the step "
+                              "that stopped (set its position and velocity, or load a checkpoint)",
+                          s.step, p.id[i], "position or velocity", std::nan(""));
+  for (std::size_t g = 0; g < s.groups.size(); ++g) {
+    const auto& grp = s.groups[g];
+    if (bad(grp.centre) || bad(grp.velocity) || bad(grp.angular_velocity))
+      throw HealthError("simulation unhealthy at step " + std::to_string(s.step) + ": group " + std::to_string(g) +
+                            " still holds the non-finite values of the step that stopped",
+                        s.step, -1, "group position or velocity", std::nan(""));
+  }
+  s.unhealthy = false;
+}
+}  // namespace
+
 std::uint64_t World::cycle(std::uint64_t n) {
   State& s = *state_;
   require(s.p.n > 0, "cycle: the world has no particles");
-  for (std::uint64_t k = 0; k < n; ++k) {
-    if (s.stop_requested.exchange(false)) return k;
-    detail::step_once(s);
+  if (s.unhealthy) recheck_health(s);
+  try {
+    for (std::uint64_t k = 0; k < n; ++k) {
+      if (s.stop_requested.exchange(false)) return k;
+      detail::step_once(s);
+    }
+  } catch (const HealthError&) {
+    s.unhealthy = true;
+    throw;
   }
   return n;
 }
 void World::request_stop() { state_->stop_requested.store(true); }
 double World::dt() const { return state_->dt; }
 void World::set_dt(double dt) {
-  require(dt >= 0 && std::isfinite(dt), "dt must be >= 0 (0: automatic), got " + num(dt));
+  require(dt == 0 || (dt >= kMinDt && std::isfinite(dt)),
+          "set_dt: dt " + num(dt) + " must be 0 (automatic) or in [" + num(kMinDt) + ", inf) s");
   state_->dt_fixed = dt > 0;
   state_->dt = dt;
   state_->last_estimate_step = 0;
   state_->need_rebuild = true;  // forces a fresh estimate (and its check) before the next step
 }
 void World::set_dt_safety(double f) {
-  require(f > 0 && f <= 2, "dt_safety must be in (0, 2], got " + num(f));
+  require(f >= kMinDtSafety && f <= 2,
+          "set_dt_safety: factor " + num(f) + " outside [" + num(kMinDtSafety) + ", 2]");
   state_->settings.dt_safety = f;
   state_->last_estimate_step = 0;
   state_->need_rebuild = true;  // a fresh estimate before the next step
@@ -783,7 +884,8 @@ void World::set_friction(double mu) {
   state_->settings.contact = m;
 }
 void World::set_skin(double skin) {
-  require(skin > 0 && std::isfinite(skin), "skin must be > 0 (m), got " + num(skin));
+  require(skin > 0 && skin <= kMaxCoordinate,
+          "set_skin: skin " + num(skin) + " outside (0, " + num(kMaxCoordinate) + "] m");
   state_->settings.skin = skin;
   state_->skin = skin;
   state_->need_rebuild = true;
@@ -796,7 +898,9 @@ double World::critical_dt() {
 std::uint64_t World::step_count() const { return state_->step; }
 double World::time() const { return state_->time; }
 void World::set_threads(int threads) {
-  require(threads >= 0, "threads must be >= 0 (0: all cores)");
+  require(threads >= 0 && threads <= kMaxThreads,
+          "set_threads: threads " + std::to_string(threads) + " outside 0.." + std::to_string(kMaxThreads) +
+              " (0: automatic)");
   state_->settings.threads = threads;
 }
 std::string World::simd_architecture() const { return state_->kernels->name; }

@@ -7,6 +7,7 @@
 // Exit status: 0 on success; 1 when the script fails (message "file:line: ..." and a traceback
 // on stderr); 2 for a bad command line; 130 when Ctrl-C ended the script.
 #include <cctype>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -56,6 +57,9 @@ bool parse_params(int argc, char** argv, int first, std::vector<std::pair<std::s
 int main(int argc, char** argv) {
   using asperity::lua::Session;
   if (argc < 2) return usage_error("no command given");
+  // Past a file-size limit (ulimit -f) a write should fail with EFBIG, which the writers report
+  // as an error naming the file; the default action of SIGXFSZ would kill the run instead.
+  std::signal(SIGXFSZ, SIG_IGN);
   std::string command = argv[1];
   try {
     if (command == "--version" || command == "-v" || command == "version") {

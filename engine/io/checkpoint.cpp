@@ -8,7 +8,10 @@
 // deterministic code that built it in the first place.
 #include <hdf5.h>
 
+#include <bit>
+#include <cmath>
 #include <cstring>
+#include <fstream>
 #include <string>
 #include <type_traits>
 
@@ -21,10 +24,15 @@ namespace asperity {
 namespace {
 
 using detail::State;
-constexpr int kCheckpointVersion = 5;  // 2: servo integral and integral time, group damping;
+constexpr int kCheckpointVersion = 6;  // 2: servo integral and integral time, group damping;
                                        // 3: rest overlaps (stress-free bonds);
                                        // 4: meshes' candidates within half the skin;
-                                       // 5: rotation_lock_bonds
+                                       // 5: a header with a checksum in the HDF5 user block;
+                                       // 6: rotation_lock_bonds
+
+// The file's kind in the header of its HDF5 user block (io::h5::file_image), whose checksum is
+// verified before HDF5 parses the file: HDF5 does not survive every corruption of its metadata.
+constexpr const char* kMagic = "asperity checkpoint\n";
 
 template <class T>
 hid_t native_type() {
@@ -119,6 +127,7 @@ struct Reader {
   void count(const std::string& name, std::vector<T>& items) {
     std::uint64_t n;
     scalar(name, n);
+    if (n > (std::uint64_t(1) << 31)) throw Error("checkpoint '" + path + "' is damaged: " + name + " = " + std::to_string(n));
     items.resize(n);
   }
 };
@@ -146,7 +155,7 @@ void visit(Io& io, State& s) {
   io.flag("settings/track_energy", ws.track_energy);
   io.scalar("settings/reorder_interval", ws.reorder_interval);
   io.flag("settings/lock_bonded_rotation", ws.lock_bonded_rotation);
-  if (io.version >= 5) io.scalar("settings/rotation_lock_bonds", ws.rotation_lock_bonds);
+  if (io.version >= 6) io.scalar("settings/rotation_lock_bonds", ws.rotation_lock_bonds);
 
   // Clock, time step, neighbour bookkeeping, ledgers.
   io.scalar("run/step", s.step);
@@ -375,38 +384,221 @@ void visit(Io& io, State& s) {
   }
 }
 
+// Everything a step or a reader relies on, checked after loading: sizes of the columns, indices
+// in range, finite values. A file that passes the checksum was written by save(); these checks
+// also cover older files without one, and a file whose checksum was forged.
+void validate(const State& s, const std::string& path) {
+  auto need = [&](bool ok, const std::string& what) {
+    if (!ok) throw Error("checkpoint '" + path + "' is damaged: " + what);
+  };
+  auto finite = [](double v) { return std::isfinite(v); };
+  auto finite3 = [](const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+  const WorldSettings& ws = s.settings;
+  for (const ContactMaterial* m : {&ws.contact}) {
+    need(m->kn > 0 && finite(m->kn) && m->ks >= 0 && finite(m->ks) && m->friction >= 0 && finite(m->friction),
+         "settings/contact");
+  }
+  need(ws.density > 0 && finite(ws.density), "settings/density");
+  need(ws.local_damping >= 0 && ws.local_damping < 1, "settings/local_damping");
+  need(finite3(ws.gravity), "settings/gravity");
+  need(ws.skin >= 0 && finite(ws.skin), "settings/skin");
+  need(ws.dt >= 0 && finite(ws.dt), "settings/dt");
+  need(ws.dt_safety > 0 && ws.dt_safety <= 2, "settings/dt_safety");
+  need(ws.dt_interval >= 1, "settings/dt_interval");
+  need(ws.reorder_interval >= 0, "settings/reorder_interval");
+  need(finite(s.time) && s.dt >= 0 && finite(s.dt) && !std::isnan(s.dt_estimate) && s.skin >= 0 && finite(s.skin),
+       "run/time, run/dt or run/skin");
+  need(finite(s.reference_energy) && finite(s.reference_input) && finite(s.kinetic_at_step), "run energies");
+  need(finite(s.ledger.friction) && finite(s.ledger.damping) && finite(s.ledger.boundary) &&
+           finite(s.ledger.gravity) && finite(s.ledger.released),
+       "ledger");
+
+  // Particles: columns of `capacity` (n real ones, then null particles), ids a permutation.
+  const auto& p = s.p;
+  const std::size_t n = p.n, cap = p.x.size();
+  need(n < (std::size_t(1) << 31) - 16 && cap >= n + 2 && cap % kMaxLanes == 0, "particles/n");
+  for (const AVec<double>* c : {&p.x, &p.y, &p.z, &p.vx, &p.vy, &p.vz, &p.wx, &p.wy, &p.wz, &p.radius,
+                                &p.mass, &p.inv_mass, &p.inertia, &p.inv_inertia, &p.fx, &p.fy, &p.fz,
+                                &p.tx, &p.ty, &p.tz, &p.x0, &p.y0, &p.z0})
+    need(c->size() == cap, "particle columns of unequal length");
+  if (p.has_applied)
+    for (const AVec<double>* c : {&p.ax, &p.ay, &p.az}) need(c->size() == cap, "particles/ax, ay, az");
+  need(p.density.size() == n && p.index_of_id.size() == n && s.user_rotation_locked.size() == n,
+       "particles/density, index_of_id or user_rotation_locked");
+  need(p.rotation_locked.size() == cap && p.group.size() == cap && p.tag.size() == cap &&
+           p.flags.size() == cap && p.inert.size() == cap && p.id.size() == cap,
+       "particle columns of unequal length");
+  const auto groups = static_cast<std::int64_t>(s.groups.size());
+  for (std::size_t i = 0; i < cap; ++i) {
+    if (i < n) {
+      need(p.id[i] >= 0 && p.id[i] < std::int64_t(n) && p.index_of_id[std::size_t(p.id[i])] == std::int64_t(i),
+           "particles/id and index_of_id do not match");
+      need(p.radius[i] > 0 && finite(p.radius[i]) && p.mass[i] > 0 && finite(p.mass[i]) &&
+               p.inertia[i] > 0 && finite(p.inertia[i]) && p.inv_mass[i] > 0 && finite(p.inv_mass[i]) &&
+               p.inv_inertia[i] > 0 && finite(p.inv_inertia[i]) && p.density[i] > 0 && finite(p.density[i]),
+           "radius, mass or inertia of particle " + std::to_string(p.id[i]));
+      for (const AVec<double>* c : {&p.x, &p.y, &p.z, &p.vx, &p.vy, &p.vz, &p.wx, &p.wy, &p.wz, &p.fx,
+                                    &p.fy, &p.fz, &p.tx, &p.ty, &p.tz, &p.x0, &p.y0, &p.z0})
+        need(finite((*c)[i]), "non-finite state of particle " + std::to_string(p.id[i]));
+      if (p.has_applied) need(finite(p.ax[i]) && finite(p.ay[i]) && finite(p.az[i]), "applied force");
+      need(p.group[i] >= -1 && p.group[i] < groups, "particles/group");
+      need(p.inert[i] <= 1 && (!p.inert[i] || p.group[i] >= 0), "particles/inert");
+    } else {
+      need(p.group[i] == -1 && p.inert[i] == 0, "null particles");
+    }
+  }
+
+  // Pair and bond lists: n entries over real particles, padding over any particle slot.
+  auto pair_like = [&](const auto& q, const char* at, std::initializer_list<const AVec<double>*> cols) {
+    need(q.n <= q.padded && q.padded % kMaxLanes == 0 && q.a.size() == q.padded && q.b.size() == q.padded,
+         std::string(at) + "/n or padded");
+    for (const AVec<double>* c : cols) need(c->size() == q.padded, std::string(at) + " columns of unequal length");
+    for (std::size_t k = 0; k < q.padded; ++k) {
+      const auto a = q.a[k], b = q.b[k];
+      if (k < q.n) {
+        need(a >= 0 && b >= 0 && std::size_t(a) < n && std::size_t(b) < n && a != b,
+             std::string(at) + ": entry " + std::to_string(k) + " refers to no particle");
+        for (const AVec<double>* c : cols) need(finite((*c)[k]), std::string(at) + ": non-finite value");
+      } else {
+        need(a >= 0 && b >= 0 && std::size_t(a) < cap && std::size_t(b) < cap, std::string(at) + ": padding");
+      }
+    }
+  };
+  for (const auto* q : {&s.pairs, &s.inherited})
+    pair_like(*q, q == &s.pairs ? "pairs" : "inherited",
+              {&q->nx, &q->ny, &q->nz, &q->fsx, &q->fsy, &q->fsz, &q->fn, &q->overlap, &q->rest});
+  const auto& b = s.bonds;
+  pair_like(b, "bonds", {&b.beam_radius, &b.nx, &b.ny, &b.nz, &b.fsx, &b.fsy, &b.fsz, &b.fn, &b.overlap,
+                         &b.fbn, &b.fbsx, &b.fbsy, &b.fbsz, &b.mbn, &b.mbsx, &b.mbsy, &b.mbsz, &b.broken, &b.rest});
+  for (std::size_t k = 0; k < b.n; ++k) need(b.beam_radius[k] >= 0, "bonds/beam_radius");
+  const BondMaterial& bm = b.material;
+  need(bm.beam_kn > 0 && finite(bm.beam_kn) && bm.beam_ks > 0 && finite(bm.beam_ks) && bm.radius_factor > 0 &&
+           finite(bm.radius_factor) && bm.tensile_strength >= 0 && finite(bm.tensile_strength),
+       "bonds/material");
+  for (const BreakEvent& e : s.break_events)
+    need(e.id_a >= 0 && e.id_b >= 0 && e.id_a < std::int64_t(n) && e.id_b < std::int64_t(n) &&
+             std::uint8_t(e.mode) <= 2,
+         "breaks");
+
+  // Walls and meshes.
+  const auto& wl = s.walls;
+  for (const auto& mesh : wl.meshes) {
+    const std::size_t nv = mesh.vertices.size(), nt = mesh.triangles.size();
+    for (const Vec3& v : mesh.vertices) need(finite3(v), "mesh vertex");
+    for (const auto& t : mesh.triangles)
+      for (int c : t) need(c >= 0 && std::size_t(c) < nv, "mesh triangle refers to no vertex");
+    need(mesh.owns.size() == nt && mesh.vertex_start.size() == nv + 1, "mesh owns or vertex_start");
+    need(mesh.vertex_start.front() == 0 && std::size_t(mesh.vertex_start.back()) == mesh.vertex_triangles.size(),
+         "mesh vertex_start");
+    for (std::size_t v = 0; v < nv; ++v) need(mesh.vertex_start[v] <= mesh.vertex_start[v + 1], "mesh vertex_start");
+    for (auto t : mesh.vertex_triangles) need(t >= 0 && std::size_t(t) < nt, "mesh vertex_triangles");
+  }
+  for (const auto& w : wl.walls) {
+    need(w.kind == detail::Wall::Kind::plane || w.kind == detail::Wall::Kind::mesh, "wall kind");
+    need(w.kind != detail::Wall::Kind::mesh || (w.mesh >= 0 && std::size_t(w.mesh) < wl.meshes.size()), "wall mesh");
+    need(finite3(w.point) && finite3(w.velocity) && finite3(w.displacement) && finite3(w.displacement_at_build) &&
+             finite3(w.force),
+         "wall state");
+    need(w.kind != detail::Wall::Kind::plane || std::fabs(norm(w.normal) - 1) < 1e-6, "plane normal");
+    const ContactMaterial& m = w.material;
+    need(m.kn > 0 && finite(m.kn) && m.ks >= 0 && finite(m.ks) && m.friction >= 0 && finite(m.friction),
+         "wall material");
+  }
+  const auto& wc = wl.contacts;
+  for (const auto* c : {&wc.nx, &wc.ny, &wc.nz, &wc.fsx, &wc.fsy, &wc.fsz, &wc.fn, &wc.overlap})
+    need(c->size() >= wc.n, "wall_contacts columns");
+  need(wc.particle.size() >= wc.n && wc.wall.size() >= wc.n && wc.facet.size() >= wc.n, "wall_contacts columns");
+  for (std::size_t k = 0; k < wc.n; ++k) {
+    need(wc.particle[k] >= 0 && std::size_t(wc.particle[k]) < n, "wall contact refers to no particle");
+    need(wc.wall[k] >= 0 && std::size_t(wc.wall[k]) < wl.walls.size(), "wall contact refers to no wall");
+    const auto& w = wl.walls[std::size_t(wc.wall[k])];
+    if (w.kind == detail::Wall::Kind::mesh)
+      need(wc.facet[k] >= 0 && std::size_t(wc.facet[k]) < wl.meshes[std::size_t(w.mesh)].triangles.size(),
+           "wall contact refers to no triangle");
+    for (const auto* c : {&wc.nx, &wc.ny, &wc.nz, &wc.fsx, &wc.fsy, &wc.fsz, &wc.fn, &wc.overlap})
+      need(finite((*c)[k]), "wall contact value");
+  }
+  for (std::size_t k = 0; k < wc.start.size(); ++k)
+    need(wc.start[k] >= 0 && std::size_t(wc.start[k]) <= wc.n && (k == 0 || wc.start[k - 1] <= wc.start[k]),
+         "wall_contacts/start");
+  need(s.need_rebuild || wc.start.empty() || wc.start.size() == n + 1, "wall_contacts/start");
+
+  // Groups: members and inert members partition the particles that name the group.
+  std::vector<std::size_t> named(s.groups.size(), 0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (p.group[i] >= 0) ++named[std::size_t(p.group[i])];
+  for (std::size_t g = 0; g < s.groups.size(); ++g) {
+    const auto& grp = s.groups[g];
+    for (const auto* list : {&grp.members, &grp.inert})
+      for (std::size_t k = 0; k < list->size(); ++k) {
+        const auto i = (*list)[k];
+        need(i >= 0 && std::size_t(i) < n && p.group[std::size_t(i)] == std::int32_t(g) &&
+                 (k == 0 || (*list)[k - 1] < i) && (list == &grp.inert) == (p.inert[std::size_t(i)] != 0),
+             "group " + std::to_string(g) + " members");
+      }
+    need(grp.members.size() + grp.inert.size() == named[g], "group " + std::to_string(g) + " members");
+    need(grp.mass > 0 && finite(grp.mass) && finite(grp.inert_mass) && finite(grp.contact_stiffness) &&
+             finite3(grp.centre) && finite3(grp.velocity) && finite3(grp.angular_velocity) &&
+             finite3(grp.applied) && finite3(grp.force) && finite3(grp.torque) && finite3(grp.inert_shift) &&
+             finite3(grp.servo_origin) && finite3(grp.servo_integral),
+         "group " + std::to_string(g) + " state");
+    const GroupMotion& m = grp.motion;
+    for (Dof d : {m.translation[0], m.translation[1], m.translation[2], m.rotation})
+      need(std::uint8_t(d) <= std::uint8_t(Dof::servo), "group " + std::to_string(g) + " modes");
+    need(m.rotation != Dof::servo && finite3(m.velocity) && finite3(m.angular_velocity) && finite(m.damping) &&
+             m.damping < 1,
+         "group " + std::to_string(g) + " motion");
+    for (const Servo& sv : m.servo)
+      need(finite(sv.target_force) && sv.stiffness >= 0 && finite(sv.stiffness) && sv.gain >= 0 && finite(sv.gain) &&
+               sv.relaxation > 0 && sv.relaxation <= 1 && sv.max_velocity > 0 && finite(sv.max_velocity) &&
+               sv.integral_time >= 0 && finite(sv.integral_time),
+           "group " + std::to_string(g) + " servo");
+  }
+}
+
 }  // namespace
 
 void World::save(const std::string& path) const {
   io::h5::quiet_errors();
   io::AtomicFile file(path);
+  std::vector<unsigned char> image;
   {
-    io::h5::Handle h(H5Fcreate(file.temp_path().c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
-    if (!h.valid()) throw Error("cannot write checkpoint '" + path + "'");
+    // Built in memory, then written by us: a full disk is reported here, before the rename, and
+    // the previous file under `path` stays as it was (io::h5::create_file).
+    const io::h5::Handle h = io::h5::create_file(file.temp_path());
     Writer w{h, path};
     int version = kCheckpointVersion;
     w.scalar("asperity_checkpoint_version", version);
     detail::sync_lazy(const_cast<State&>(*state_));  // idle members to where they are (not observable)
     visit(w, const_cast<State&>(*state_));  // the writer only reads (and fills the fn and U columns from the records)
+    image = io::h5::file_image(h, path, kMagic);
   }
+  io::write_bytes(file.temp_path(), image, path, true);
   file.commit();
 }
 
 World World::load(const std::string& path, int threads, const std::string& simd) {
   io::h5::quiet_errors();
-  if (H5Fis_hdf5(path.c_str()) <= 0) throw Error("cannot read checkpoint '" + path + "': not an HDF5 file");
-  io::h5::Handle h(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
-  if (!h.valid()) throw Error("cannot read checkpoint '" + path + "'");
+  if (threads < 0 || threads > kMaxThreads)
+    throw Error("load: threads " + std::to_string(threads) + " outside 0.." + std::to_string(kMaxThreads));
+  // The whole file, checked before HDF5 sees it (older checkpoints have no header: HDF5 and the
+  // checks after loading are all they get), then opened from the bytes read.
+  bool had_header = false;
+  std::vector<unsigned char> bytes = io::h5::read_checked(path, kMagic, &had_header);
+  io::h5::Handle h = io::h5::open_image(bytes, path);
+  bytes = {};
   Reader r{h, path};
   int version = 0;
   r.scalar("asperity_checkpoint_version", version);
   if (version < 1 || version > kCheckpointVersion)
     throw Error("checkpoint '" + path + "' has version " + std::to_string(version) +
                 ", this build reads versions 1 to " + std::to_string(kCheckpointVersion));
+  if (version >= 5 && !had_header) throw Error("checkpoint '" + path + "' is damaged: its header is missing");
   r.version = version;
   World world;
   State& s = world.state();
   visit(r, s);
+  validate(s, path);
   s.settings.threads = threads;
   s.settings.simd = simd;
   s.kernels = &kernels::select_kernels(simd);

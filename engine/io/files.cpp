@@ -12,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 #include <system_error>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include "asperity/io.hpp"
@@ -49,15 +50,50 @@ void AtomicFile::commit() {
   committed_ = true;
 }
 
+void write_bytes(const fs::path& temp, std::span<const unsigned char> bytes, const std::string& target,
+                 bool sync) {
+  auto failed = [&](const char* what, int err) {
+    return Error("cannot write '" + target + "': " + what + ": " + std::strerror(err));
+  };
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw failed("open", errno);
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t w = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) {
+      const int err = w < 0 ? errno : ENOSPC;
+      ::close(fd);
+      throw failed("write", err);
+    }
+    done += static_cast<std::size_t>(w);
+  }
+  if (sync && ::fsync(fd) != 0) {
+    const int err = errno;
+    ::close(fd);
+    throw failed("fsync", err);
+  }
+  // Some file systems (NFS, or a delayed allocation) report a full disk only here.
+  if (::close(fd) != 0) throw failed("close", errno);
+}
+
+bool is_complete_png(const fs::path& path) {
+  static constexpr unsigned char kEnd[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  unsigned char tail[12] = {};
+  const bool ok = std::fseek(f, -12, SEEK_END) == 0 && std::fread(tail, 1, 12, f) == 12 &&
+                  std::memcmp(tail, kEnd, 12) == 0;
+  std::fclose(f);
+  return ok;
+}
+
 void write_text_file(const fs::path& path, std::string_view contents) {
   AtomicFile file(path);
-  {
-    std::ofstream out(file.temp_path(), std::ios::binary);
-    if (!out) throw Error("cannot write '" + path.string() + "': " + std::strerror(errno));
-    out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
-    out.flush();
-    if (!out) throw Error("cannot write '" + path.string() + "': write failed");
-  }
+  write_bytes(file.temp_path(),
+              std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(contents.data()),
+                                             contents.size()),
+              path.string());
   file.commit();
 }
 

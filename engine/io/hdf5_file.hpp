@@ -50,9 +50,36 @@ class Handle {
 
 void quiet_errors();
 
-// A new file (truncating), for writing. Tracks link creation order so datasets list in the order
-// they were written.
+// A new file for writing, built in memory (HDF5's core driver without a backing store) and put on
+// disk by write_image: HDF5 itself then never writes to the disk, so a full disk is an error of
+// ours, raised before the rename. (A failed H5Fclose on a full disk leaves HDF5 with a file it
+// cannot close, and its clean-up at exit crashes.) Tracks link creation order so datasets list
+// in the order they were written. The first kHeaderBytes are HDF5's user block (HDF5 finds its
+// superblock after it; h5py, h5dump and ParaView read the file as usual), for write_image's header.
 Handle create_file(const std::filesystem::path& path);
+
+// The header in the user block: a magic line naming the kind of file ("asperity hdf5\n",
+// "asperity checkpoint\n"; at most 23 bytes), the byte count of the rest and its checksum, so
+// that a damaged file is refused before HDF5 parses it: HDF5 1.10 does not survive every
+// corruption of its own metadata (it frees wild pointers).
+inline constexpr std::size_t kHeaderBytes = 512;
+inline constexpr const char* kFileMagic = "asperity hdf5\n";
+
+// The complete image of a file from create_file, with the header filled in.
+std::vector<unsigned char> file_image(hid_t file, const std::string& name, const char* magic = kFileMagic);
+// file_image written to `temp` (an AtomicFile's temporary path) with every write checked;
+// sync: flushed to the device too.
+void write_image(hid_t file, const std::filesystem::path& temp, const std::string& name,
+                 const char* magic = kFileMagic, bool sync = false);
+
+// A whole file read for opening, its header checked when it has one (files written by other
+// programs have none: they start with HDF5's signature). `magic`: the kind required (nullptr:
+// any asperity header, or none). *had_header tells which it was.
+std::vector<unsigned char> read_checked(const std::filesystem::path& path, const char* magic = nullptr,
+                                        bool* had_header = nullptr);
+// A file opened (read only) from bytes of read_checked.
+Handle open_image(const std::vector<unsigned char>& bytes, const std::filesystem::path& path);
+
 Handle open_file_read(const std::filesystem::path& path);
 Handle create_group(hid_t parent, const std::string& name, const std::string& file);
 

@@ -118,6 +118,7 @@ void plot_png(const fs::path& path, const Column& x, std::span<const Column> ys,
       }
       out << '\n';
     }
+    out.close();  // a full disk may show only here
     if (!out) throw Error("plot: cannot write the data file in " + dir.path().string());
   }
 
@@ -154,7 +155,7 @@ void plot_png(const fs::path& path, const Column& x, std::span<const Column> ys,
   int status = run_program({"gnuplot", script.string()}, log);
   if (status == -1)
     throw Error("plot '" + path.string() + "': cannot run gnuplot (install gnuplot-nox)");
-  if (status != 0 || !fs::exists(png.temp_path()) || fs::file_size(png.temp_path()) == 0)
+  if (status != 0 || !is_complete_png(png.temp_path()))
     throw Error("plot '" + path.string() + "': gnuplot failed (status " + std::to_string(status) +
                 "): " + read_all(log));
   png.commit();

@@ -48,8 +48,8 @@ void Series::write_hdf5(const std::filesystem::path& path) const {
     }
     h5::write_attribute(f, "columns", names, path.string());
     h5::write_attributes(f, attributes_, path.string());
-    if (H5Fflush(f, H5F_SCOPE_LOCAL) < 0) throw Error("HDF5 file '" + path.string() + "': flush failed");
-  }  // closed before the rename
+    h5::write_image(f, file.temp_path(), path.string());
+  }
   file.commit();
 }
 

@@ -139,7 +139,7 @@ void write_snapshot_hdf5(const std::filesystem::path& path, const Snapshot& s) {
       h5::write_doubles(g, "tau", s.bond_tau, 0, "Pa", name);
       h5::write_doubles(g, "gap", s.bond_gap, 0, "m", name);
     }
-    if (H5Fflush(f, H5F_SCOPE_LOCAL) < 0) throw Error("HDF5 file '" + name + "': flush failed");
+    h5::write_image(f, file.temp_path(), name);
   }
   file.commit();
 }

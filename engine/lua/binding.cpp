@@ -162,6 +162,19 @@ Vec3 check_vec(lua_State* L, int arg) {
   type_error(arg, "vector {x, y, z}", L, arg);
 }
 
+std::string number_text(double v) {
+  if (std::isnan(v)) return "nan";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.15g", v);
+  return buf;
+}
+
+int int_in(lua_Integer v, const std::string& what, lua_Integer lo, lua_Integer hi) {
+  if (v < lo || v > hi)
+    throw Error(what + " " + std::to_string(v) + " outside " + std::to_string(lo) + ".." + std::to_string(hi));
+  return static_cast<int>(v);
+}
+
 std::int64_t check_id(lua_State* L, int arg, std::size_t count, const char* kind) {
   lua_Integer id = check_integer(L, arg);
   if (id < 1 || static_cast<std::size_t>(id) > count) {

@@ -74,6 +74,10 @@ bool check_boolean(lua_State* L, int arg);
 void check_function(lua_State* L, int arg);
 void check_table(lua_State* L, int arg);
 Vec3 check_vec(lua_State* L, int arg);
+// A number as a user wrote it: "6", "0.5", "1e+300", "nan" (std::to_string would give "6.000000").
+std::string number_text(double v);
+// v as an int, or an Error naming `what` when it lies outside [lo, hi] (a plain cast would wrap).
+int int_in(lua_Integer v, const std::string& what, lua_Integer lo, lua_Integer hi);
 // A 1-based Lua id -> 0-based engine index; `count` items exist. kind: "particle", "wall"...
 std::int64_t check_id(lua_State* L, int arg, std::size_t count, const char* kind);
 

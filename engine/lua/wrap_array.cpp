@@ -186,8 +186,15 @@ int array_new(lua_State* L) {
     if (lua_type(L, 1) == LUA_TNUMBER) {
       lua_Integer rows = check_integer(L, 1);
       lua_Integer cols = opt_integer(L, 2, 1);
-      if (rows < 0) throw ArgError{1, "rows must be >= 0"};
-      if (cols < 1) throw ArgError{2, "cols must be >= 1"};
+      // Bounded so that rows * cols neither overflows nor asks for more memory than a machine has.
+      constexpr lua_Integer kMaxElements = lua_Integer(1) << 28;  // 2 GiB of doubles
+      if (rows < 0 || rows > kMaxElements)
+        throw ArgError{1, "rows " + std::to_string(rows) + " outside 0.." + std::to_string(kMaxElements)};
+      if (cols < 1 || cols > kMaxElements)
+        throw ArgError{2, "cols " + std::to_string(cols) + " outside 1.." + std::to_string(kMaxElements)};
+      if (rows * cols > kMaxElements)
+        throw ArgError{1, std::to_string(rows) + " x " + std::to_string(cols) + " elements, more than " +
+                              std::to_string(kMaxElements)};
       double fill = opt_number(L, 3, 0.0);
       push_array(L, std::vector<double>(static_cast<std::size_t>(rows * cols), fill),
                  static_cast<std::size_t>(cols));
@@ -213,7 +220,8 @@ int array_row(lua_State* L) {
   return guarded(L, [&] {
     Array& a = self(L);
     std::size_t i = check_row(L, 2, a);
-    luaL_checkstack(L, static_cast<int>(a.cols), "row too wide");
+    if (a.cols > 100000 || !lua_checkstack(L, static_cast<int>(a.cols)))
+      throw Error("a:row: " + std::to_string(a.cols) + " columns are too many to return as values (use a:get)");
     for (std::size_t j = 0; j < a.cols; ++j) lua_pushnumber(L, a.data[i * a.cols + j]);
     return static_cast<int>(a.cols);
   });
@@ -282,7 +290,8 @@ int reduce(lua_State* L, Init init, Step step, Finish finish) {
     std::vector<double> acc(a.cols, init(a));
     for (std::size_t i = 0; i < a.rows(); ++i)
       for (std::size_t j = 0; j < a.cols; ++j) acc[j] = step(acc[j], a.data[i * a.cols + j]);
-    luaL_checkstack(L, static_cast<int>(a.cols), "too many columns");
+    if (a.cols > 100000 || !lua_checkstack(L, static_cast<int>(a.cols)))
+      throw Error("Array: " + std::to_string(a.cols) + " columns are too many to return as values");
     for (double v : acc) lua_pushnumber(L, finish(v, a));
     return static_cast<int>(a.cols);
   });

@@ -17,6 +17,9 @@ namespace {
 io::Json to_json(lua_State* L, int index, int depth, const std::string& where) {
   index = absolute(L, index);
   if (depth > 64) throw Error("asperity.write_json: nesting deeper than 64 at " + where + " (a cycle?)");
+  // Each level holds a key and a value on the Lua stack, which a C function must reserve: past
+  // LUA_MINSTACK slots the pushes would write beyond the stack.
+  if (!lua_checkstack(L, 4)) throw Error("asperity.write_json: out of Lua stack at " + where);
   switch (lua_type(L, index)) {
     case LUA_TNIL: return nullptr;
     case LUA_TBOOLEAN: return lua_toboolean(L, index) != 0;

@@ -164,6 +164,49 @@ void push_ids(lua_State* L, const std::vector<std::int64_t>& ids) {
 
 // --- reading options ------------------------------------------------------------------------
 
+int integer_in(lua_Integer v, const char* what, lua_Integer lo, lua_Integer hi, const std::string& ctx) {
+  if (v < lo || v > hi)
+    throw Error(ctx + ": " + what + " " + std::to_string(v) + " outside " + std::to_string(lo) +
+                ".." + std::to_string(hi));
+  return static_cast<int>(v);
+}
+
+std::string g6(double v) {
+  if (std::isnan(v)) return "nan";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+// A number argument that must be finite (angles, lengths, offsets): NaN or infinity would reach
+// integer conversions and loop bounds in the analysis.
+double finite_arg(lua_State* L, int arg, const char* what) {
+  const double v = check_number(L, arg);
+  if (!std::isfinite(v)) throw ArgError{arg, std::string(what) + " must be finite, got " + g6(v)};
+  return v;
+}
+double opt_finite_arg(lua_State* L, int arg, const char* what, double fallback) {
+  return lua_isnoneornil(L, arg) ? fallback : finite_arg(L, arg, what);
+}
+// A lag or step length: finite and >= 0 (0: the default).
+double opt_length_arg(lua_State* L, int arg, const char* what) {
+  const double v = opt_finite_arg(L, arg, what, 0.0);
+  if (v < 0) throw ArgError{arg, std::string(what) + " must be >= 0 (m; 0: the default), got " + g6(v)};
+  return v;
+}
+double finite_option(Options& o, const char* key, double fallback) {
+  const double v = o.number(key, fallback);
+  if (!std::isfinite(v)) throw Error(o.context() + ": option '" + key + "' must be finite, got " + g6(v));
+  return v;
+}
+// A 1-based index into n items, checked before any arithmetic on it.
+int index_arg(lua_State* L, int arg, lua_Integer n, const char* what) {
+  const lua_Integer i = check_integer(L, arg);
+  if (i < 1 || i > n)
+    throw ArgError{arg, std::string(what) + " " + std::to_string(i) + " outside 1.." + std::to_string(n)};
+  return static_cast<int>(i - 1);
+}
+
 sf::Window window_named(const std::string& name, const std::string& context) {
   if (name == "hann") return sf::Window::hann;
   if (name == "none") return sf::Window::none;
@@ -173,18 +216,26 @@ sf::Window window_named(const std::string& name, const std::string& context) {
 // Fields of AnalysisOptions, read from an Options table (finish() is the caller's).
 sf::AnalysisOptions read_analysis_options(Options& o) {
   sf::AnalysisOptions a;
+  const std::string& ctx = o.context();
+  // Lengths and frequencies finite (NaN or inf would reach integer conversions); counts bounded
+  // (each is a loop count: a billion directions is a hang, not an analysis).
+  auto length = [&](const char* key, double fallback) {
+    const double v = finite_option(o, key, fallback);
+    if (v < 0) throw Error(ctx + ": option '" + key + "' must be >= 0, got " + g6(v));
+    return v;
+  };
   a.remove_mean_plane = o.boolean("remove_mean_plane", a.remove_mean_plane);
   a.window = window_named(o.string("window", "hann"), o.context());
-  a.max_lag = o.number("max_lag", a.max_lag);
-  a.structure_fit_min_lag = o.number("structure_fit_min_lag", a.structure_fit_min_lag);
-  a.structure_fit_max_lag = o.number("structure_fit_max_lag", a.structure_fit_max_lag);
-  a.psd_fit_min_frequency = o.number("psd_fit_min_frequency", a.psd_fit_min_frequency);
-  a.psd_fit_max_frequency = o.number("psd_fit_max_frequency", a.psd_fit_max_frequency);
-  a.directions = static_cast<int>(o.integer("directions", a.directions));
-  a.sector_half_width = o.number("sector_half_width", a.sector_half_width);
-  a.abbott_levels = static_cast<int>(o.integer("abbott_levels", a.abbott_levels));
-  a.colatitude_bins = static_cast<int>(o.integer("colatitude_bins", a.colatitude_bins));
-  a.slope_max_steps = static_cast<int>(o.integer("slope_max_steps", a.slope_max_steps));
+  a.max_lag = length("max_lag", a.max_lag);
+  a.structure_fit_min_lag = length("structure_fit_min_lag", a.structure_fit_min_lag);
+  a.structure_fit_max_lag = length("structure_fit_max_lag", a.structure_fit_max_lag);
+  a.psd_fit_min_frequency = length("psd_fit_min_frequency", a.psd_fit_min_frequency);
+  a.psd_fit_max_frequency = length("psd_fit_max_frequency", a.psd_fit_max_frequency);
+  a.directions = integer_in(o.integer("directions", a.directions), "directions", 1, 3600, ctx);
+  a.sector_half_width = finite_option(o, "sector_half_width", a.sector_half_width);
+  a.abbott_levels = integer_in(o.integer("abbott_levels", a.abbott_levels), "abbott_levels", 2, 1 << 20, ctx);
+  a.colatitude_bins = integer_in(o.integer("colatitude_bins", a.colatitude_bins), "colatitude_bins", 1, 1 << 20, ctx);
+  a.slope_max_steps = integer_in(o.integer("slope_max_steps", a.slope_max_steps), "slope_max_steps", 1, 1 << 20, ctx);
   return a;
 }
 
@@ -195,12 +246,6 @@ sf::AnalysisOptions analysis_options(lua_State* L, int index, const std::string&
   return a;
 }
 
-int integer_in(lua_Integer v, const char* what, lua_Integer lo, lua_Integer hi, const std::string& ctx) {
-  if (v < lo || v > hi)
-    throw Error(ctx + ": " + what + " " + std::to_string(v) + " outside " + std::to_string(lo) +
-                ".." + std::to_string(hi));
-  return static_cast<int>(v);
-}
 
 // Generation parameters from a table: a reference surface by name, overridden field by field,
 // or all of H (or Hx, Hy), Lc (or Lcx, Lcy) and variance.
@@ -293,7 +338,7 @@ int l_load(lua_State* L) {
   return guarded(L, [&] {
     const std::string path = check_string(L, 1);
     Options o(L, 2, "asperity.surface.load", 2);
-    const double spacing = o.number("spacing", 0.0);
+    const double spacing = finite_option(o, "spacing", 0.0);
     o.finish();
     push_map(L, sf::load_hdf5(path, spacing));
     return 1;
@@ -305,8 +350,8 @@ int l_load_grid(lua_State* L) {
     const std::string path = check_string(L, 1);
     Options o(L, 2, "asperity.surface.load_grid", 2);
     sf::GridImportOptions g;
-    g.spacing = o.number("spacing", g.spacing);
-    g.height_scale = o.number("height_scale", g.height_scale);
+    g.spacing = finite_option(o, "spacing", g.spacing);
+    g.height_scale = finite_option(o, "height_scale", g.height_scale);
     o.finish();
     push_map(L, sf::load_grid(path, g));
     return 1;
@@ -325,7 +370,8 @@ int l_height_map(lua_State* L) {
     std::vector<double> h = check_numbers(L, lua_gettop(L), &cols);
     lua_pop(L, 1);
     o.finish();
-    if (!(spacing > 0)) throw Error("asperity.surface.height_map: give spacing = grid step (m) > 0");
+    if (!(spacing > 0) || !std::isfinite(spacing))
+      throw Error("asperity.surface.height_map: give spacing = grid step (m), finite and > 0, got " + g6(spacing));
     const std::size_t nx = cols > 1 ? cols : static_cast<std::size_t>(nx_given);
     if (nx < 1 || h.empty() || h.size() % nx != 0)
       throw Error("asperity.surface.height_map: " + std::to_string(h.size()) +
@@ -411,6 +457,11 @@ int l_profilometer(lua_State* L) {
       grid.ny = integer_in(g.integer("ny", grid.nx), "grid.ny", 1, 1 << 16, ctx);
       grid.spacing = g.number("spacing", 0.0);
       g.finish();
+      if (!(grid.spacing > 0) || !std::isfinite(grid.spacing))
+        throw Error(ctx + ": grid.spacing must be a finite length > 0 (m), got " + g6(grid.spacing));
+      if (std::int64_t(grid.nx) * grid.ny > (std::int64_t(1) << 26))
+        throw Error(ctx + ": grid of " + std::to_string(grid.nx) + " x " + std::to_string(grid.ny) +
+                    " nodes, more than 2^26");
     } else {
       throw Error(ctx + ": give grid = a HeightMap (its grid) or {nx=, ny=, spacing=}");
     }
@@ -418,8 +469,9 @@ int l_profilometer(lua_State* L) {
     if (o.push_checked("origin", LUA_TTABLE, "a table {x0, y0} (m)") == LUA_TTABLE) {
       lua_rawgeti(L, -1, 1);
       lua_rawgeti(L, -2, 2);
-      if (lua_type(L, -2) != LUA_TNUMBER || lua_type(L, -1) != LUA_TNUMBER)
-        throw Error(ctx + ": origin must be {x0, y0} (m)");
+      if (lua_type(L, -2) != LUA_TNUMBER || lua_type(L, -1) != LUA_TNUMBER ||
+          !std::isfinite(lua_tonumber(L, -2)) || !std::isfinite(lua_tonumber(L, -1)))
+        throw Error(ctx + ": origin must be {x0, y0} of finite numbers (m)");
       grid.x0 = lua_tonumber(L, -2);
       grid.y0 = lua_tonumber(L, -1);
       lua_pop(L, 2);
@@ -435,7 +487,7 @@ int l_profilometer(lua_State* L) {
       std::size_t c = 1;
       for (double v : check_numbers(L, lua_gettop(L), &c)) {
         if (v != std::floor(v) || v < 1 || v > static_cast<double>(radii.size()))
-          throw Error(ctx + ": no particle " + std::to_string(v) + " in ids (valid: 1.." +
+          throw Error(ctx + ": no particle " + number_text(v) + " in ids (valid: 1.." +
                       std::to_string(radii.size()) + ")");
         subset.push_back(static_cast<std::int64_t>(v) - 1);
       }
@@ -500,9 +552,9 @@ sf::DemMeanPlane mean_plane_of(lua_State* L, const sf::HeightMap& dem, const sf:
                                int options_index, const std::string& context, int arg) {
   Options o(L, options_index, context, arg);
   sf::DemMeanPlaneOptions m;
-  m.levels = static_cast<int>(o.integer("levels", m.levels));
-  m.bandwidth = o.number("bandwidth", m.bandwidth);
-  m.tolerance = o.number("tolerance", m.tolerance);
+  m.levels = integer_in(o.integer("levels", m.levels), "levels", 2, 1 << 20, context);
+  m.bandwidth = finite_option(o, "bandwidth", m.bandwidth);
+  m.tolerance = finite_option(o, "tolerance", m.tolerance);
   o.finish();
   return sf::dem_mean_plane(dem, syn, m);
 }
@@ -545,7 +597,15 @@ int l_classify(lua_State* L) {
     if (std::isnan(band)) throw Error(ctx + ": give band = (m)");
     if (!shift) shift = sf::dem_mean_plane(dem, syn).shift;
     std::vector<std::int64_t> node(ids->data.size());
-    for (std::size_t k = 0; k < node.size(); ++k) node[k] = static_cast<std::int64_t>(ids->data[k]) - 1;
+    // The array may have been edited (or built by hand): each entry is a particle id from 1 or 0
+    // (no particle), checked before the conversion to an integer.
+    for (std::size_t k = 0; k < node.size(); ++k) {
+      const double v = ids->data[k];
+      if (!(v >= 0 && v <= 9007199254740992.0) || v != std::floor(v))
+        throw ArgError{1, "particle[" + std::to_string(k + 1) + "] = " + g6(v) +
+                              " is not a particle id (an integer >= 1, or 0 for none)"};
+      node[k] = static_cast<std::int64_t>(v) - 1;
+    }
     const sf::SurfaceParticles r = sf::classify_surface_particles(dem, node, syn, *shift, band);
     lua_createtable(L, 0, 6);
     push_ids(L, r.surface);
@@ -568,11 +628,13 @@ int l_noise_study(lua_State* L) {
     if (o.push("levels") != LUA_TNIL) {
       std::size_t c = 1;
       levels = check_numbers(L, lua_gettop(L), &c);
+      if (levels.size() > 1000) throw Error("asperity.surface.noise_study: " + std::to_string(levels.size()) + " levels, at most 1000");
     } else {
       for (int k = 0; k <= 10; ++k) levels.push_back(0.1 * k);
     }
     lua_pop(L, 1);
     const lua_Integer seed = o.integer("seed", 1);
+    if (seed < 0) throw Error("asperity.surface.noise_study: seed must be >= 0, got " + std::to_string(seed));
     const sf::AnalysisOptions a = read_analysis_options(o);
     o.finish();
     const auto study = sf::noise_study(m, levels, static_cast<std::uint64_t>(seed), a);
@@ -743,7 +805,7 @@ int map_remove_mean_plane(lua_State* L) {
 // Direction argument: an angle (rad), "x", "y" or "radial" (default).
 std::optional<double> direction_arg(lua_State* L, int arg) {
   if (lua_isnoneornil(L, arg)) return std::nullopt;
-  if (lua_type(L, arg) == LUA_TNUMBER) return lua_tonumber(L, arg);
+  if (lua_type(L, arg) == LUA_TNUMBER) return finite_arg(L, arg, "angle (rad)");
   if (lua_type(L, arg) == LUA_TSTRING) {
     const std::string s = lua_tostring(L, arg);
     if (s == "radial") return std::nullopt;
@@ -759,7 +821,7 @@ int map_lags(lua_State* L) {
   return guarded(L, [&] {
     const sf::HeightMap& m = map_arg(L, 1);
     const auto angle = direction_arg(L, 2);
-    const double max_lag = opt_number(L, 3, 0.0);
+    const double max_lag = opt_length_arg(L, 3, "max_lag");
     const sf::LagMap lags(m);
     sf::LagSeries s = Structure ? (angle ? lags.structure_function(*angle, max_lag)
                                          : lags.structure_function_radial(max_lag))
@@ -776,7 +838,8 @@ int map_psd(lua_State* L) {
     const sf::HeightMap& m = map_arg(L, 1);
     Options o(L, 2, "map:psd", 2);
     auto angle = o.number("angle");
-    const double half_width = o.number("half_width", std::numbers::pi / 8);
+    if (angle && !std::isfinite(*angle)) throw Error("map:psd: option 'angle' must be finite");
+    const double half_width = finite_option(o, "half_width", std::numbers::pi / 8);
     const sf::Window w = window_named(o.string("window", "hann"), "map:psd");
     o.finish();
     push_spectrum(L, angle ? sf::sector_psd(m, *angle, half_width, w) : sf::radial_psd(m, w));
@@ -788,7 +851,10 @@ int map_slopes(lua_State* L) {
   return guarded(L, [&] {
     const sf::HeightMap& m = map_arg(L, 1);
     const double angle = direction_arg(L, 2).value_or(0.0);
-    const int steps = static_cast<int>(opt_integer(L, 3, 20));
+    const lua_Integer max_steps = opt_integer(L, 3, 20);
+    if (max_steps < 1 || max_steps > 1 << 20)
+      throw ArgError{3, "max_steps " + std::to_string(max_steps) + " outside 1.." + std::to_string(1 << 20)};
+    const int steps = static_cast<int>(max_steps);
     const sf::SlopeSeries s = sf::slope_statistics(m, angle, steps);
     lua_createtable(L, 0, 4);
     set_number(L, "angle", s.angle);
@@ -804,8 +870,8 @@ int map_colatitude(lua_State* L) {
     const sf::HeightMap& m = map_arg(L, 1);
     const double angle = direction_arg(L, 2).value_or(0.0);
     Options o(L, 3, "map:colatitude", 3);
-    const double step = o.number("step", 0.0);
-    const int bins = static_cast<int>(o.integer("bins", 90));
+    const double step = finite_option(o, "step", 0.0);
+    const int bins = integer_in(o.integer("bins", 90), "bins", 1, 1 << 20, "map:colatitude");
     o.finish();
     const sf::ColatitudeDistribution c = sf::colatitude_distribution(m, angle, step, bins);
     lua_createtable(L, 0, 11);
@@ -827,7 +893,10 @@ int map_colatitude(lua_State* L) {
 int map_abbott(lua_State* L) {
   return guarded(L, [&] {
     const sf::HeightMap& m = map_arg(L, 1);
-    push_abbott(L, sf::abbott_curve(m, static_cast<int>(opt_integer(L, 2, 201))));
+    const lua_Integer levels = opt_integer(L, 2, 201);
+    if (levels < 2 || levels > 1 << 20)
+      throw ArgError{2, "levels " + std::to_string(levels) + " outside 2.." + std::to_string(1 << 20)};
+    push_abbott(L, sf::abbott_curve(m, static_cast<int>(levels)));
     return 1;
   });
 }
@@ -849,7 +918,7 @@ void push_profile(lua_State* L, sf::Profile p) {
 int map_row(lua_State* L) {
   return guarded(L, [&] {
     const sf::HeightMap& m = map_arg(L, 1);
-    push_profile(L, sf::row_profile(m, static_cast<int>(check_integer(L, 2) - 1)));
+    push_profile(L, sf::row_profile(m, index_arg(L, 2, m.ny, "row")));
     return 2;
   });
 }
@@ -857,7 +926,7 @@ int map_row(lua_State* L) {
 int map_column(lua_State* L) {
   return guarded(L, [&] {
     const sf::HeightMap& m = map_arg(L, 1);
-    push_profile(L, sf::column_profile(m, static_cast<int>(check_integer(L, 2) - 1)));
+    push_profile(L, sf::column_profile(m, index_arg(L, 2, m.nx, "column")));
     return 2;
   });
 }
@@ -865,8 +934,8 @@ int map_column(lua_State* L) {
 int map_profile(lua_State* L) {
   return guarded(L, [&] {
     const sf::HeightMap& m = map_arg(L, 1);
-    push_profile(L, sf::line_profile(m, check_number(L, 2), check_number(L, 3), check_number(L, 4),
-                                     opt_number(L, 5, 0.0)));
+    push_profile(L, sf::line_profile(m, finite_arg(L, 2, "x0 (m)"), finite_arg(L, 3, "y0 (m)"),
+                                     finite_arg(L, 4, "angle (rad)"), opt_length_arg(L, 5, "step")));
     return 2;
   });
 }
@@ -874,7 +943,7 @@ int map_profile(lua_State* L) {
 int map_shifted(lua_State* L) {
   return guarded(L, [&] {
     sf::HeightMap m = map_arg(L, 1);
-    const double dz = check_number(L, 2);
+    const double dz = finite_arg(L, 2, "dz (m)");
     for (double& z : m.height) z += dz;
     push_map(L, std::move(m));
     return 1;

@@ -78,11 +78,11 @@ int world_new(lua_State* L) {
     s.dt = o.number("dt", s.dt);
     s.dt_safety = o.number("dt_safety", s.dt_safety);
     s.allow_dt_above_estimate = o.boolean("allow_dt_above_estimate", s.allow_dt_above_estimate);
-    s.dt_interval = static_cast<int>(o.integer("dt_interval", s.dt_interval));
-    s.threads = static_cast<int>(o.integer("threads", s.threads));
+    s.dt_interval = int_in(o.integer("dt_interval", s.dt_interval), "asperity.world: dt_interval", 1, 1 << 30);
+    s.threads = int_in(o.integer("threads", s.threads), "asperity.world: threads", 0, kMaxThreads);
     s.simd = o.string("simd", s.simd);
     s.track_energy = o.boolean("track_energy", s.track_energy);
-    s.reorder_interval = static_cast<int>(o.integer("reorder_interval", s.reorder_interval));
+    s.reorder_interval = int_in(o.integer("reorder_interval", s.reorder_interval), "asperity.world: reorder_interval", 0, 1 << 30);
     s.lock_bonded_rotation = o.boolean("lock_bonded_rotation", s.lock_bonded_rotation);
     s.rotation_lock_bonds = static_cast<int>(o.integer("rotation_lock_bonds", s.rotation_lock_bonds));
     o.finish();
@@ -329,7 +329,7 @@ int world_add_mesh(lua_State* L) {
         double idx = tflat[3 * t + static_cast<std::size_t>(k)];
         if (idx != std::floor(idx) || idx < 1 || idx > static_cast<double>(vertices.size()))
           throw Error("world:add_mesh: triangle " + std::to_string(t + 1) +
-                      " refers to vertex " + std::to_string(idx) + " (vertices are 1.." +
+                      " refers to vertex " + number_text(idx) + " (vertices are 1.." +
                       std::to_string(vertices.size()) + ")");
         triangles[t][static_cast<std::size_t>(k)] = static_cast<int>(idx) - 1;
       }
@@ -526,7 +526,7 @@ std::vector<std::int64_t> ids_arg(lua_State* L, int arg, const World& w, const c
   if (v.empty()) throw ArgError{arg, "the list of particle ids is empty"};
   for (double x : v) {
     if (x != std::floor(x) || x < 1 || x > static_cast<double>(n))
-      throw ArgError{arg, "no particle " + std::to_string(x) + " (valid: 1.." + std::to_string(n) + ")"};
+      throw ArgError{arg, "no particle " + number_text(x) + " (valid: 1.." + std::to_string(n) + ")"};
     ids.push_back(static_cast<std::int64_t>(x) - 1);
   }
   return ids;
@@ -566,7 +566,7 @@ int world_set_tag(lua_State* L) {
   return guarded(L, [&] {
     World& w = world_arg(L);
     std::vector<std::int64_t> ids = ids_arg(L, 2, w, "world:set_tag");
-    w.set_tag(ids, static_cast<int>(check_integer(L, 3)));
+    w.set_tag(ids, int_in(check_integer(L, 3), "world:set_tag: tag", INT32_MIN, INT32_MAX));
     return 0;
   });
 }
@@ -601,8 +601,8 @@ int world_flags(lua_State* L) {
 int world_contact_summary(lua_State* L) {
   return guarded(L, [&] {
     World& w = world_arg(L);
-    int a = static_cast<int>(check_integer(L, 2));
-    int b = static_cast<int>(check_integer(L, 3));
+    int a = int_in(check_integer(L, 2), "world:contact_summary: tag_a", INT32_MIN, INT32_MAX);
+    int b = int_in(check_integer(L, 3), "world:contact_summary: tag_b", INT32_MIN, INT32_MAX);
     lua_Integer mask = opt_integer(L, 4, 0);
     if (mask < 0 || mask > 255) throw ArgError{4, "a flag mask is 8 bits (0..255)"};
     ContactSummary c = w.contact_summary(a, b, static_cast<std::uint8_t>(mask));
@@ -677,7 +677,7 @@ int world_install_bonds(lua_State* L) {
 int world_save(lua_State* L) {
   return guarded(L, [&] {
     World& w = world_arg(L);
-    const char* path = luaL_checkstring(L, 2);
+    const std::string path = check_string(L, 2);
     w.save(path);
     return 0;
   });
@@ -685,12 +685,12 @@ int world_save(lua_State* L) {
 
 int l_load(lua_State* L) {
   return guarded(L, [&] {
-    const std::string path = luaL_checkstring(L, 1);
+    const std::string path = check_string(L, 1);
     int threads = 0;
     std::string simd = "auto";
     if (!lua_isnoneornil(L, 2)) {
       Options o(L, 2, "asperity.load", 2);
-      threads = static_cast<int>(o.integer("threads", threads));
+      threads = int_in(o.integer("threads", threads), "asperity.load: threads", 0, kMaxThreads);
       simd = o.string("simd", simd);
       o.finish();
     }
@@ -1067,7 +1067,7 @@ int world_time(lua_State* L) {
 int world_set_threads(lua_State* L) {
   return guarded(L, [&] {
     World& w = world_arg(L);
-    w.set_threads(static_cast<int>(check_integer(L, 2)));
+    w.set_threads(int_in(check_integer(L, 2), "world:set_threads: threads", 0, kMaxThreads));
     return 0;
   });
 }
@@ -1195,7 +1195,8 @@ void open_world(lua_State* L) {
   static const Function methods[] = {
       // particles
       {"add_particle", world_add_particle, "world:add_particle(pos, radius [, density]) -> id",
-       "Adds a sphere at pos {x, y, z}; density defaults to the world's. Ids count from 1."},
+       "Adds a sphere at pos {x, y, z}; density defaults to the world's. Ids count from 1.\n"
+       "Accepted: radius 1e-6..1e3 m, density 1e-6..1e9 kg/m^3, |x|, |y|, |z| <= 1e9 m."},
       {"add_particles", world_add_particles,
        "world:add_particles(positions, radii [, density]) -> first_id, last_id",
        "Adds many spheres at once: positions an n x 3 Array or {{x,y,z}, ...}; radii an Array,\n"
@@ -1333,7 +1334,7 @@ void open_world(lua_State* L) {
       {"dt", world_dt, "world:dt() -> s", "The time step in use."},
       {"set_dt", set_world_number<&World::set_dt>, "world:set_dt(dt)", "Fixes the time step (0: automatic again)."},
       {"set_dt_safety", set_world_number<&World::set_dt_safety>, "world:set_dt_safety(f)",
-       "Automatic time step = f x the critical estimate (default 0.8; 0 < f <= 2)."},
+       "Automatic time step = f x the critical estimate (default 0.8; 0.001 <= f <= 2)."},
       {"set_skin", set_world_number<&World::set_skin>, "world:set_skin(m)", "Verlet skin in m (the list is rebuilt)."},
       {"set_friction", set_world_number<&World::set_friction>, "world:set_friction(mu)",
        "Ball-ball Coulomb coefficient from the next step on (walls keep theirs)."},

@@ -51,8 +51,11 @@ struct CellGrid {
   std::vector<std::int32_t> group_of_cell;
 
   int clampi(double v, int n) const {
-    int i = static_cast<int>(std::floor(v / cell));
-    return std::clamp(i, 0, n - 1);
+    const double c = std::floor(v / cell);
+    // Compared as doubles first: a cast of a value outside int's range is undefined.
+    if (!(c > 0)) return 0;
+    if (c >= double(n - 1)) return n - 1;
+    return static_cast<int>(c);
   }
   void coords(double x, double y, double z, int& i, int& j, int& k) const {
     i = clampi(x - ox, nx);
@@ -61,7 +64,7 @@ struct CellGrid {
   }
 };
 
-CellGrid make_grid(const ParticleStore& p, double skin) {
+CellGrid make_grid(const ParticleStore& p, double skin, std::uint64_t step) {
   CellGrid g;
   const std::size_t n = p.n;
   double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, rmax = 0;
@@ -74,6 +77,20 @@ CellGrid make_grid(const ParticleStore& p, double skin) {
     }
     rmax = std::max(rmax, p.radius[i]);
   }
+  // A runaway particle (the health check stops the step that makes a position non-finite, but
+  // a finite one may still be far out) must not make the extent overflow: the loop below would
+  // then grow the cells forever.
+  for (int d = 0; d < 3; ++d)
+    if (!std::isfinite(hi[d] - lo[d])) {
+      std::size_t far = 0;
+      double worst = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        const double c[3] = {p.x[i], p.y[i], p.z[i]};
+        if (!p.inert[i] && !(std::fabs(c[d]) <= worst)) worst = std::fabs(c[d]), far = i;
+      }
+      throw HealthError("neighbour search: particles spread over a non-finite extent (a runaway "
+                        "particle)", step, p.id[far], "position", worst);
+    }
   // Cell edge >= the largest Ra + Rb + skin, so a pair within reach is in adjacent cells.
   g.cell = std::max(2 * rmax + skin, 1e-12);
   // A sparse scene would make the grid huge: grow the cells until there are at most ~2 per
@@ -482,11 +499,11 @@ void build_neighbors(State& s) {
   ParticleStore& p = s.p;
   sync_lazy(s);  // idle group members are searched: bring them to where they are
   ensure_skin(s);
-  CellGrid grid = make_grid(p, s.skin);
+  CellGrid grid = make_grid(p, s.skin, s.step);
   const int every = s.settings.reorder_interval;
   if (p.n > 0 && (s.force_reorder || (every > 0 && s.rebuilds_since_reorder >= std::uint64_t(every)))) {
     reorder(s, grid);
-    grid = make_grid(p, s.skin);
+    grid = make_grid(p, s.skin, s.step);
     s.rebuilds_since_reorder = 0;
     s.force_reorder = false;
   }

@@ -82,6 +82,19 @@ void require_map(const HeightMap& map, const char* who) {
     if (!(map.spacing > 0)) throw Error(std::string(who) + ": spacing must be > 0");
 }
 
+void require_finite_value(double v, const char* who, const char* what) {
+    if (!std::isfinite(v))
+        throw Error(std::string(who) + ": " + what + " must be finite, got " + std::to_string(v));
+}
+
+// Lags (or rings) up to max_lag, as an int no larger than `cap`: converted in double first, as a
+// max_lag of 1e300 cast straight to int is undefined.
+int lag_count(double max_lag, double spacing, int cap) {
+    const double k = std::floor(max_lag / spacing + 1e-9);
+    if (!(k > 0)) return 0;
+    return k >= cap ? cap : static_cast<int>(k);
+}
+
 void require_profile(const Profile& p, const char* who) {
     if (p.height.size() < 3)
         throw Error(std::string(who) + ": the profile needs at least 3 heights");
@@ -173,6 +186,8 @@ double LagMap::pairs_at(int dx, int dy) const {
 }
 
 LagSeries LagMap::along(Quantity q, double angle, double max_lag) const {
+    require_finite_value(angle, "structure_function", "angle");
+    require_finite_value(max_lag, "structure_function", "max_lag");
     if (max_lag <= 0) max_lag = default_max_lag(nx_, ny_, spacing_);
     const auto& data = q == Quantity::structure ? structure_ : covariance_;
     auto step = detail::direction_step(angle);
@@ -207,9 +222,11 @@ LagSeries LagMap::along(Quantity q, double angle, double max_lag) const {
 }
 
 LagSeries LagMap::radial(Quantity q, double max_lag) const {
+    require_finite_value(max_lag, "structure_function_radial", "max_lag");
     if (max_lag <= 0) max_lag = default_max_lag(nx_, ny_, spacing_);
     const auto& data = q == Quantity::structure ? structure_ : covariance_;
-    const int rings = static_cast<int>(std::floor(max_lag / spacing_ + 1e-9));
+    // No lag on the map is longer than nx + ny steps.
+    const int rings = lag_count(max_lag, spacing_, nx_ + ny_);
     std::vector<CompensatedSum> value(rings + 1), lag(rings + 1);
     std::vector<double> pairs(rings + 1, 0.0);
     const int reach_x = std::min(rings, nx_ - 1), reach_y = std::min(rings, ny_ - 1);
@@ -267,8 +284,9 @@ namespace {
 LagSeries profile_lags(const Profile& p, double max_lag, bool structure) {
     require_profile(p, structure ? "structure_function" : "autocovariance");
     const int n = static_cast<int>(p.height.size());
+    require_finite_value(max_lag, structure ? "structure_function" : "autocovariance", "max_lag");
     if (max_lag <= 0) max_lag = 0.5 * n * p.spacing;
-    const int lags = std::min(n - 1, static_cast<int>(std::floor(max_lag / p.spacing + 1e-9)));
+    const int lags = lag_count(max_lag, p.spacing, n - 1);
     const double mean = mean_of(p.height);
     LagSeries out;
     out.angle = not_a_number;
@@ -504,6 +522,7 @@ double rolloff_length(const Spectrum& s, const PowerLawFit& fit) {
 
 SlopeSeries slope_statistics(const HeightMap& map, double angle, int max_steps) {
     require_map(map, "slope_statistics");
+    require_finite_value(angle, "slope_statistics", "angle");
     const auto dir = detail::direction_step(angle);
     SlopeSeries out;
     out.angle = angle;
@@ -567,6 +586,8 @@ public:
         for (int b = 0; b <= bins; ++b) out_.bin_edges.push_back(0.5 * pi * b / bins);
     }
     void add(double dz) {
+        // A node without a height (NaN: a profilometer's uncovered node) has no colatitude.
+        if (!std::isfinite(dz)) return;
         const double theta = std::atan(dz / step_);  // [2-17]
         ++out_.samples;
         if (theta == 0) return;  // a flat step faces neither way
@@ -610,6 +631,8 @@ private:
 ColatitudeDistribution colatitude_distribution(const HeightMap& map, double angle, double step,
                                                int bins) {
     require_map(map, "colatitude_distribution");
+    require_finite_value(angle, "colatitude_distribution", "angle");
+    require_finite_value(step, "colatitude_distribution", "step");
     const auto dir = detail::direction_step(angle);
     if (step <= 0) step = dir.length * map.spacing;  // one lattice step on x, y, diagonals
     const double gx = std::cos(angle) * step / map.spacing;

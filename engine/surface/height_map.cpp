@@ -10,6 +10,7 @@
 //   with a large offset still gives its variance to rounding.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -54,7 +55,20 @@ Profile column_profile(const HeightMap& map, int column) {
 }
 
 Profile line_profile(const HeightMap& map, double x0, double y0, double angle, double step) {
+    for (double v : {x0, y0, angle, step})
+        if (!std::isfinite(v)) throw Error("line_profile: x0, y0, angle and step must be finite");
     if (step <= 0) step = map.spacing;
+    // The walk below visits every point of the line inside the map: at most its diagonal over the
+    // step, which a tiny step would make endless.
+    constexpr double kMaxPoints = 1e7;
+    const double diagonal = std::hypot(double(map.nx), double(map.ny)) * map.spacing;
+    if (!(diagonal / step <= kMaxPoints))
+    {
+        char m[200];
+        std::snprintf(m, sizeof m, "line_profile: step %.6g m would give up to %.6g points (at most "
+                      "1e7; the map's spacing is %.6g m)", step, diagonal / step, map.spacing);
+        throw Error(m);
+    }
     const double gx0 = x0 / map.spacing, gy0 = y0 / map.spacing;
     const double dx = std::cos(angle) * step / map.spacing, dy = std::sin(angle) * step / map.spacing;
     if (std::isnan(detail::sample(map, gx0, gy0)))

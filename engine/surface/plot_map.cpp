@@ -100,6 +100,7 @@ void plot_height_map_png(const HeightMap& map, const std::string& path,
             const double v = z * options.height_scale;
             out.write(reinterpret_cast<const char*>(&v), sizeof v);
         }
+        out.close();  // a full disk may show only here
         if (!out) throw Error("plot_height_map_png: cannot write " + data.string());
     }
     const double h = map.spacing * options.length_scale;
@@ -142,7 +143,7 @@ void plot_height_map_png(const HeightMap& map, const std::string& path,
     const int status = run_gnuplot(script, log);
     if (status == -1)
         throw Error("plot '" + path + "': cannot run gnuplot (install gnuplot-nox)");
-    if (status != 0 || !fs::exists(png.temp_path()) || fs::file_size(png.temp_path()) == 0) {
+    if (status != 0 || !io::is_complete_png(png.temp_path())) {
         std::ifstream in(log);
         std::stringstream text;
         text << in.rdbuf();

@@ -44,15 +44,18 @@ inline DirectionStep direction_step(double angle) {
 inline double sample(const HeightMap& map, double gx, double gy) {
     if (near_integer(gx)) gx = std::round(gx);
     if (near_integer(gy)) gy = std::round(gy);
-    if (gx < 0 || gy < 0 || gx > map.nx - 1 || gy > map.ny - 1) return std::nan("");
+    // Written so that NaN (from a non-finite spacing or step) is outside too.
+    if (!(gx >= 0 && gy >= 0 && gx <= map.nx - 1 && gy <= map.ny - 1)) return std::nan("");
     int i = static_cast<int>(std::floor(gx));
     int j = static_cast<int>(std::floor(gy));
     double fx = gx - i, fy = gy - j;
     if (fx == 0 && fy == 0) return map.at(i, j);
-    if (i == map.nx - 1) { --i; fx = 1.0; }
-    if (j == map.ny - 1) { --j; fy = 1.0; }
-    const double z00 = map.at(i, j), z10 = map.at(i + 1, j);
-    const double z01 = map.at(i, j + 1), z11 = map.at(i + 1, j + 1);
+    if (i == map.nx - 1 && i > 0) { --i; fx = 1.0; }
+    if (j == map.ny - 1 && j > 0) { --j; fy = 1.0; }
+    // A map one node wide has no neighbour along that axis (and there fx or fy is 0).
+    const int i1 = map.nx > 1 ? i + 1 : i, j1 = map.ny > 1 ? j + 1 : j;
+    const double z00 = map.at(i, j), z10 = map.at(i1, j);
+    const double z01 = map.at(i, j1), z11 = map.at(i1, j1);
     return (1 - fy) * ((1 - fx) * z00 + fx * z10) + fy * ((1 - fx) * z01 + fx * z11);
 }
 

@@ -27,7 +27,9 @@
 #include <system_error>
 
 #include "asperity/error.hpp"
+#include "asperity/io.hpp"
 #include "asperity/surface.hpp"
+#include "io/hdf5_file.hpp"
 
 namespace asperity::surface {
 namespace {
@@ -157,10 +159,11 @@ bool parse_double(const std::string& token, double& value) {
 void save_hdf5(const HeightMap& map, const std::string& path) {
     if (map.height.size() != static_cast<std::size_t>(map.nx) * map.ny || map.nx < 1)
         throw Error("save_hdf5: the map's nx * ny does not match its heights");
-    const std::string tmp = path + ".tmp";
+    // Built in memory and written with every write checked, under a temporary name renamed over
+    // the target only when complete (io.hpp: AtomicFile, h5::create_file).
+    io::AtomicFile atomic(path);
     {
-        Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose,
-                    "creating " + tmp);
+        const io::h5::Handle file = io::h5::create_file(atomic.temp_path());
         const hsize_t dims[2] = {static_cast<hsize_t>(map.ny), static_cast<hsize_t>(map.nx)};
         Handle space(H5Screate_simple(2, dims, nullptr), H5Sclose, "dataspace");
         Handle dset(H5Dcreate2(file, "height", H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT,
@@ -184,17 +187,16 @@ void save_hdf5(const HeightMap& map, const std::string& path) {
             write_scalar(dset, "seed", H5T_STD_U64LE, H5T_NATIVE_UINT64, p.seed);
             write_string(dset, "name", p.name);
         }
+        io::h5::write_image(file, atomic.temp_path(), path);
     }
-    std::error_code ec;
-    std::filesystem::rename(tmp, path, ec);
-    if (ec) throw Error("save_hdf5: cannot rename " + tmp + " to " + path + ": " + ec.message());
+    atomic.commit();
 }
 
 HeightMap load_hdf5(const std::string& path, double spacing_override) {
     if (!std::filesystem::exists(path)) throw Error("load_hdf5: no file " + path);
-    if (H5Fis_hdf5(path.c_str()) <= 0)
-        throw Error("load_hdf5: " + path + " is not an HDF5 file");
-    Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose, "opening " + path);
+    // Read whole and its header checked first (io::h5::read_checked): HDF5 does not survive every
+    // damaged file.
+    const io::h5::Handle file = io::h5::open_file_read(path);
     if (H5Lexists(file, "height", H5P_DEFAULT) <= 0)
         throw Error("load_hdf5: " + path + " has no dataset 'height'");
     Handle dset(H5Dopen2(file, "height", H5P_DEFAULT), H5Dclose, "opening dataset height");
@@ -218,7 +220,8 @@ HeightMap load_hdf5(const std::string& path, double spacing_override) {
         throw Error("load_hdf5: " + path +
                                  ": dataset 'height' has no 'spacing' attribute; pass the spacing "
                                  "(m) to load_hdf5");
-    if (!(map.spacing > 0)) throw Error("load_hdf5: " + path + ": spacing must be > 0");
+    if (!(map.spacing > 0) || !std::isfinite(map.spacing))
+        throw Error("load_hdf5: " + path + ": spacing must be finite and > 0");
 
     if (has_attribute(dset, "hurst_x")) {
         SurfaceParams p;
@@ -244,10 +247,8 @@ HeightMap load_hdf5(const std::string& path, double spacing_override) {
 void save_csv(const HeightMap& map, const std::string& path) {
     if (map.height.size() != static_cast<std::size_t>(map.nx) * map.ny || map.nx < 1)
         throw Error("save_csv: the map's nx * ny does not match its heights");
-    const std::string tmp = path + ".tmp";
     {
-        std::ofstream out(tmp);
-        if (!out) throw Error("save_csv: cannot write " + tmp);
+        std::ostringstream out;
         char buf[32];
         auto number = [&](double v) {
             const auto res = std::to_chars(buf, buf + sizeof buf, v);  // shortest round trip
@@ -265,11 +266,9 @@ void save_csv(const HeightMap& map, const std::string& path) {
             }
             out << line << '\n';
         }
-        if (!out) throw Error("save_csv: error writing " + tmp);
+        // Written under a temporary name with every write checked (io::write_text_file).
+        io::write_text_file(path, out.str());
     }
-    std::error_code ec;
-    std::filesystem::rename(tmp, path, ec);
-    if (ec) throw Error("save_csv: cannot rename " + tmp + " to " + path + ": " + ec.message());
 }
 
 HeightMap load_grid(const std::string& path, const GridImportOptions& options) {
@@ -364,7 +363,7 @@ HeightMap load_grid(const std::string& path, const GridImportOptions& options) {
     if (options.height_scale != 1.0)
         for (double& z : map.height) z *= options.height_scale;
     map.spacing = options.spacing > 0 ? options.spacing : file_spacing;
-    if (!(map.spacing > 0))
+    if (!(map.spacing > 0) || !std::isfinite(map.spacing))
         throw Error("load_grid: " + path +
                                  " gives no spacing ('# spacing = <m>' or ESRI cellsize); set "
                                  "GridImportOptions.spacing");

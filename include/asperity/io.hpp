@@ -55,6 +55,14 @@ class AtomicFile {
 };
 
 void write_text_file(const std::filesystem::path& path, std::string_view contents);
+// True when `path` ends with a PNG's IEND chunk: a program that writes PNGs (gnuplot) may exit 0
+// after a write failed on a full disk, leaving a truncated image.
+bool is_complete_png(const std::filesystem::path& path);
+// Writes `bytes` to `temp` (an AtomicFile's temporary path) with every write and the close
+// checked, so that a full disk or a file-size limit is an Error naming `target`, never a short
+// file that looks complete. sync: also flush it to the device before returning (checkpoints).
+void write_bytes(const std::filesystem::path& temp, std::span<const unsigned char> bytes,
+                 const std::string& target, bool sync = false);
 // mkdir -p; an existing directory is fine, an existing file of that name is an Error.
 void make_directories(const std::filesystem::path& path);
 

@@ -24,6 +24,19 @@ namespace detail {
 struct State;
 }
 
+// Bounds of the values a World accepts (an Error names the value outside them). Wide enough for
+// any scene of this engine (mm particles in a cm specimen, or metre-sized test bodies), narrow
+// enough that what the step derives from them stays finite: mass rho 4/3 pi R^3 and inertia
+// 2/5 m R^2 (model.md 2) neither overflow nor underflow, and the cell grids' extents
+// (differences of coordinates) cannot overflow.
+inline constexpr double kMinDensity = 1e-6, kMaxDensity = 1e9;     // kg/m^3
+inline constexpr double kMinRadius = 1e-6, kMaxRadius = 1e3;       // m
+inline constexpr double kMaxCoordinate = 1e9;                      // m, |x|, |y|, |z|
+inline constexpr double kMinStiffness = 1e-12, kMaxStiffness = 1e15;  // N/m (kn; ks may be 0)
+inline constexpr double kMinDt = 1e-15;                            // s, a fixed time step
+inline constexpr double kMinDtSafety = 1e-3;                       // dt / critical estimate
+inline constexpr int kMaxThreads = 1024;                           // OpenMP threads asked for
+
 // Contact springs and friction (model.md 4). Source values: kn = 0.1 N/m, ks = kn/10, mu = 0.5.
 struct ContactMaterial {
   double kn = 0.1;         // normal stiffness, N/m

@@ -111,3 +111,97 @@ TEST(Checkpoint, MissingOrForeignFileIsAClearError) {
   }
   std::filesystem::remove(path);
 }
+
+namespace {
+std::string read_file(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  std::string s;
+  char buf[65536];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) s.append(buf, n);
+  std::fclose(f);
+  return s;
+}
+void write_file(const std::string& path, const std::string& s) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  std::fwrite(s.data(), 1, s.size(), f);
+  std::fclose(f);
+}
+std::string load_error(const std::string& path) {
+  try {
+    World::load(path);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(loaded)";
+}
+
+// A scene with a bit of everything a checkpoint holds: pairs, bonds, a mesh, a group.
+World busy_scene() {
+  WorldSettings ws;
+  ws.dt = 5e-4;
+  World w = test::random_box(80, ws);
+  std::vector<Vec3> v{{0, 0, 1e-3}, {0.012, 0, 1e-3}, {0, 0.012, 1e-3}, {0.012, 0.012, 1e-3}};
+  std::vector<std::array<int, 3>> t{{0, 1, 3}, {0, 3, 2}};
+  w.add_mesh(v, t);
+  w.cycle(600);
+  BondMaterial bm;
+  bm.tensile_strength = 1;
+  w.install_bonds(bm, 2e-5);
+  w.add_group(std::vector<std::int64_t>{0, 1, 2}, GroupMotion{});
+  w.cycle(50);
+  return w;
+}
+}  // namespace
+
+// A flipped byte anywhere, or a truncated file, is refused by the checksum before HDF5 reads it.
+TEST(Checkpoint, DamagedOrTruncatedFileIsRefused) {
+  World w = busy_scene();
+  const std::string path = temp_file("asperity_checkpoint_flipped.h5");
+  w.save(path);
+  const std::string good = read_file(path);
+  ASSERT_GT(good.size(), 4096u);
+  for (std::size_t at : {std::size_t(30), std::size_t(600), good.size() / 3, good.size() - 1}) {
+    std::string bad = good;
+    bad[at] = static_cast<char>(bad[at] ^ 0x10);
+    write_file(path, bad);
+    const std::string e = load_error(path);
+    EXPECT_TRUE(e.find("damaged") != std::string::npos || e.find("header") != std::string::npos) << at << ": " << e;
+  }
+  write_file(path, good.substr(0, good.size() / 2));
+  EXPECT_NE(load_error(path).find("truncated or damaged"), std::string::npos);
+  write_file(path, good);
+  EXPECT_EQ(World::load(path).particle_count(), w.particle_count());
+  std::filesystem::remove(path);
+}
+
+// A file whose checksum is right but whose contents are not (here: saved from a damaged state) is
+// refused by the checks after loading, which name what is wrong, before a step can use it.
+TEST(Checkpoint, InconsistentContentsAreRefusedByName) {
+  const World base = busy_scene();
+  ASSERT_GT(base.state().pairs.n, 0u);
+  ASSERT_GT(base.state().bonds.n, 0u);
+  const std::string path = temp_file("asperity_checkpoint_inconsistent.h5");
+  struct Case {
+    const char* message;
+    void (*damage)(detail::State&);
+  };
+  const Case cases[] = {
+      {"particles/id and index_of_id", [](detail::State& s) { s.p.id[0] = s.p.id[1]; }},
+      {"non-finite state of particle", [](detail::State& s) { s.p.wx[3] = std::nan(""); }},
+      {"radius, mass or inertia", [](detail::State& s) { s.p.inertia[2] = 0; }},
+      {"pairs: entry 0 refers to no particle", [](detail::State& s) { s.pairs.a[0] = std::int32_t(s.p.n + 7); }},
+      {"bonds: entry 0 refers to no particle", [](detail::State& s) { s.bonds.b[0] = -1; }},
+      {"mesh triangle refers to no vertex", [](detail::State& s) { s.walls.meshes[0].triangles[1][2] = 99; }},
+      {"particles/group", [](detail::State& s) { s.p.group[5] = 7; }},
+      {"settings/dt_interval", [](detail::State& s) { s.settings.dt_interval = 0; }},
+  };
+  for (const Case& c : cases) {
+    World w = World::load([&] { base.save(path); return path; }());
+    c.damage(w.state());
+    w.save(path);
+    const std::string e = load_error(path);
+    EXPECT_NE(e.find("is damaged"), std::string::npos) << c.message << ": " << e;
+    EXPECT_NE(e.find(c.message), std::string::npos) << c.message << ": " << e;
+  }
+  std::filesystem::remove(path);
+}

@@ -1,0 +1,106 @@
+// Bad values at the API boundary and non-finite state inside the step: refused by name, or
+// stopped by the health check; never a hang, a crash or a success with NaN state.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "state.hpp"
+
+using namespace asperity;
+
+namespace {
+World pair_of_spheres() {
+  World w;
+  w.add_particle({0, 0, 0}, 1e-3);
+  w.add_particle({1.9e-3, 0, 0}, 1e-3);
+  return w;
+}
+std::string error_of(auto&& call) {
+  try {
+    call();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+}  // namespace
+
+TEST(Robustness, ValuesOutsideTheirBoundsAreRefusedByName) {
+  World w = pair_of_spheres();
+  EXPECT_EQ(error_of([&] { w.add_particle({0, 0, 0}, 1e-3, 1e-300); }),
+            "add_particle: density 1e-300 outside [1e-06, 1e+09] kg/m^3");
+  EXPECT_EQ(error_of([&] { w.add_particle({0, 0, 0}, 1e200); }), "add_particle: radius 1e+200 outside [1e-06, 1000] m");
+  EXPECT_NE(error_of([&] { w.add_particle({-1.7e308, 0, 0}, 1e-3); }).find("add_particle: position (-1.7e+308, 0, 0) outside"),
+            std::string::npos);
+  EXPECT_EQ(error_of([&] { w.set_dt_safety(1e-320); }).rfind("set_dt_safety: factor", 0), 0u);
+  EXPECT_EQ(w.particle_count(), 2u);
+  // A plane normal whose square overflows is normalised all the same.
+  const int plane = w.add_plane({0, 0, -0.01}, {0, 0, 1e200});
+  EXPECT_EQ(w.state().walls.walls[std::size_t(plane)].normal, (Vec3{0, 0, 1}));
+}
+
+TEST(Robustness, AFailedAddGroupLeavesTheWorldAsItWas) {
+  World w = pair_of_spheres();
+  GroupMotion m;
+  m.translation = {Dof::free, Dof::free, Dof::servo};
+  m.servo[2].max_velocity = -1;
+  const std::int64_t ids[] = {0, 1};
+  EXPECT_NE(error_of([&] { w.add_group(ids, m); }).find("servo on z: max_velocity must be > 0"), std::string::npos);
+  EXPECT_EQ(w.group_count(), 0u);
+  EXPECT_EQ(w.group_of(0), -1);
+  EXPECT_EQ(w.group_of(1), -1);
+  w.cycle(20);  // once read past the group's members
+  EXPECT_EQ(w.add_group(ids, GroupMotion{}), 0);
+  w.cycle(20);
+}
+
+// The displacement check does not see a spin; the kinetic energy of the step does.
+TEST(Robustness, NonFiniteAngularVelocityStopsTheStep) {
+  World w = pair_of_spheres();
+  w.cycle(1);
+  w.state().p.wz[w.state().p.index_of_id[1]] = std::nan("");  // inf is caught as a turn of more than 0.1 rad
+  w.state().spin_known = false;
+  try {
+    w.cycle(5);
+    FAIL() << "the step went on";
+  } catch (const HealthError& e) {
+    EXPECT_EQ(e.particle_id, 1);
+    EXPECT_EQ(e.quantity, "kinetic energy");
+  }
+}
+
+// Particles spread over more than the largest double (a run-away): an error, not a cell grid that
+// grows its cells forever.
+TEST(Robustness, ParticlesSpreadBeyondTheRangeOfDoublesStopTheStep) {
+  World w = pair_of_spheres();
+  auto& p = w.state().p;
+  p.x[p.index_of_id[0]] = -1.7e308;
+  p.x[p.index_of_id[1]] = 1.7e308;
+  EXPECT_THROW(w.rebuild_neighbors(), HealthError);
+  w.state().need_rebuild = true;
+  try {
+    w.cycle(1);
+    FAIL() << "the step went on";
+  } catch (const HealthError& e) {
+    EXPECT_NE(std::string(e.what()).find("non-finite extent"), std::string::npos);
+  }
+}
+
+// After a stopped step the world keeps its non-finite values for inspection; no later cycle may
+// succeed while any are left, even where the step would not touch them (a fixed group's member).
+TEST(Robustness, NoCycleSucceedsWhileAStoppedStepsNaNIsLeft) {
+  World w = pair_of_spheres();
+  w.state().p.vx[w.state().p.index_of_id[0]] = std::nan("");
+  EXPECT_THROW(w.cycle(1), HealthError);
+  GroupMotion fixed;
+  fixed.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
+  const std::int64_t member[] = {0};
+  w.add_group(member, fixed);
+  try {
+    w.cycle(3);
+    FAIL() << "a cycle succeeded with a NaN left";
+  } catch (const HealthError& e) {
+    EXPECT_NE(std::string(e.what()).find("still holds the non-finite values"), std::string::npos) << e.what();
+  }
+}
