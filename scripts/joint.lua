@@ -27,86 +27,99 @@ local radii_lib = require("radii")
 local genesis = require("genesis")
 local heightmap = require("heightmap")
 
-local P = require("params").defaults{
-  surface = "S1",          -- S1..S8 (surfaces.md table 4), or "flat" (a plane: the control case)
-  surface_file = "",       -- or an HDF5 height map (dataset `height`, attribute `spacing`)
-  scale = "",              -- "thesis": size 0.1 m (about 110 000 particles)
-  size = 0.02,             -- side of the square joint, m
-  thickness = 0.006,       -- each half beyond the mean plane, m
-  spacing = 0.1 / 365,     -- surface grid spacing, m (the thesis grid)
-  model = "elastic",       -- rigid | elastic | fracture
-  stress = 14,             -- normal stress, MPa (scaled)
-  direction = "x",         -- x | y: the upper half moves along -x or -y
-  shear = 5,               -- shear displacement, mm
-  velocity = 1.5e-5,       -- shear velocity, m/s (perf/runtime_vs_error.lua: within 1 % of a 2x slower run)
-  ramp = 0.05,             -- mm over which the shear velocity rises linearly from 0 (no start-up impact)
-  quasi_static_limit = 0.01, -- warn when the kinetic energy exceeds this x normal load x mean radius
-  overlap_limit = 0.5,     -- warn when a contact overlaps this fraction of the smaller radius (the engine
-                           -- stops at 1): the contacts are too soft for the load (perf/README.md)
-  normal_control = "servo", -- servo (model.md 7, with integral action), load: a constant force on a free platen,
-                           -- or stiffness: constant normal stiffness, sigma_0 + normal_stiffness x dilatancy
-  normal_stiffness = 0,    -- MPa/mm (scaled) of normal_control=stiffness
-  platen_damping = 0,      -- local damping of the dead-load platen (< 0: the world's)
-  servo_relaxation = 0.4,  -- servo gain: fraction of the force error the platen contacts correct per step
-  servo_integral_steps = 2, -- integral time of the servo, in time steps (0: proportional only, model.md 7)
-  servo_max_velocity = 100, -- the servo's speed limit, in shear velocities
-  closure_velocity = 6e-5, -- m/s [thesis 4.2.2]
-  closure_every = 0,       -- steps between closure records (the source: 500; 0: 50, or 1 for the rigid
-                           -- model, whose large time step closes the joint in a few dozen steps)
-  approach_gap = 0.2e-3,    -- m, smallest gap left between the halves after lowering the upper one
-  gap = 1e-3,              -- m, between the halves while they relax
-  platen = 1.5e-3,         -- m, layer of each outer face that forms a platen
-  porosity = mat.genesis.porosity,  -- thesis definition [3-35]: the particle count of the genesis
-  genesis_stress = mat.genesis.stress, -- Pa, isotropic stress installed before bonding (scenarios.md 1)
-  bond_gap = 0,            -- m, largest gap bonded (0: the engine's default, 1e-3 x mean radius)
-  wall_friction = 0,       -- of the box walls and the mould during the genesis (scenarios.md 1: frictionless)
-  seed = 1,
-  pack_steps = 300000,     -- most steps spent cycling the packing towards the ratio 1e-4
-  record = 0.01,           -- mm of shear between records
-  dt_safety = 0,           -- time step / critical estimate for closure and shear; 0: 1.0 for the elastic
-                           -- and fracture models (changes no result by more than 0.2 %,
-                           -- perf/runtime_vs_error.lua), the engine's 0.8 for the rigid one (its
-                           -- bodies' estimate is coarser: 1.0 ran away while closing a tiny joint)
-  skin = 0,                -- Verlet skin, m (0: 0.1 mean radius, the rigid model 0.4; perf/README.md)
-  snapshots = "0,1,2.5,5", -- mm of shear
-  band = 0,                -- surface vs porosity band, m (0: mean radius)
-  out = "out/joint",
-  cache = "out/cache",
-  threads = 0,
-  simd = "auto",           -- kernels of closure and shear: auto, an architecture, or "float" (the force laws
-                           -- in single precision, scalar: perf/runtime_vs_error.lua's study); packing: auto
-  progress = true,
-  events_every = 0,        -- steps between energy samples for the event statistics (events.{h5,csv}); 0: none
-  save = "",               -- a path: the world's checkpoint when the shear ends (to continue from it,
-                           -- or to time the shear step in one process: perf/README.md, perf/ab.sh)
-  stop_after = "",         -- "packing": stop once the halves are packed, before bonding (the world
-                           -- saved to `save` if given: to look at the packing, or to time its step)
+local params_lib = require("params")
+local R = mat.packing.mean_radius
+local P = params_lib.parse{
+  script = "joint.lua",
+  path = "scripts/joint.lua",
+  about = "a rock joint closed and sheared under constant normal load",
+  {"surface", "S1", oneof = {"S1", "S2", "S3", "S4", "S5", "S6", "S7", "S8", "flat"},
+   doc = "reference surface (surfaces.md table 4), or flat: a plane, the control case"},
+  {"surface_file", "", file = true, doc = "an HDF5 height map instead (dataset `height`, attribute `spacing`)"},
+  {"scale", "", oneof = {"", "thesis"}, doc = "thesis: size 0.1 m (about 110 000 particles) unless size is given"},
+  {"size", 0.02, unit = "m", min = 4 * R, doc = "side of the square joint"},
+  {"thickness", 0.006, unit = "m", min = 2 * R, doc = "each half beyond the mean plane"},
+  {"spacing", 0.1 / 365, unit = "m", above = 0, doc = "surface grid spacing (the thesis grid)"},
+  {"model", "elastic", oneof = {"rigid", "elastic", "fracture"},
+   doc = "rigid bodies, unbreakable bonds, or the calibrated breakable bonds [scenarios.md 4]"},
+  {"stress", 14, unit = "MPa", above = 0, doc = "normal stress, scaled to rock (model Pa x stress scale)"},
+  {"direction", "x", oneof = {"x", "y"}, doc = "the upper half moves along -x or -y"},
+  {"shear", 5, unit = "mm", above = 0, doc = "shear displacement"},
+  {"residual_window", 0.5, unit = "mm", above = 0, doc = "the residual stress is the mean over the last this much of the shear"},
+  {"velocity", 1.5e-5, unit = "m/s", above = 0, doc = "shear velocity (perf/runtime_vs_error.lua: within 1 % of a 2x slower run)"},
+  {"ramp", 0.05, unit = "mm", min = 0, doc = "the shear velocity rises linearly from 0 over this displacement"},
+  {"quasi_static_limit", 0.01, above = 0, doc = "warn when the kinetic energy exceeds this x normal load x mean radius"},
+  {"overlap_limit", 0.5, above = 0, max = 1,
+   doc = "warn when a contact overlaps this fraction of the smaller radius (the engine stops at 1)"},
+  {"normal_control", "servo", oneof = {"servo", "load", "stiffness"},
+   doc = "servo (model.md 7, with integral action), load: a constant force on a free platen, or stiffness: "
+         .. "constant normal stiffness, sigma_0 + normal_stiffness x dilatancy"},
+  {"normal_stiffness", 0, unit = "MPa/mm", min = 0, doc = "scaled to rock; of normal_control=stiffness (> 0 there, 0 otherwise)"},
+  {"platen_damping", 0, below = 1, doc = "local damping of the dead-load platen (< 0: the world's)"},
+  {"servo_relaxation", 0.4, above = 0, max = 1, doc = "servo gain: fraction of the force error corrected per step"},
+  {"servo_integral_steps", 2, min = 0, doc = "integral time of the servo, in time steps (0: proportional only)"},
+  {"servo_max_velocity", 100, above = 0, doc = "the servo's speed limit, in shear velocities"},
+  {"closure_velocity", 6e-5, unit = "m/s", above = 0, doc = "closure velocity [thesis 4.2.2]"},
+  {"closure_every", 0, type = "integer", min = 0,
+   doc = "steps between closure records (0: 50, or 1 for the rigid model, which closes in a few dozen steps)"},
+  {"approach_gap", 0.2e-3, unit = "m", min = 0, doc = "smallest gap left between the halves after lowering the upper one"},
+  {"gap", 1e-3, unit = "m", min = 0, doc = "between the halves while they relax"},
+  {"platen", 1.5e-3, unit = "m", above = 0, doc = "layer of each outer face that forms a platen"},
+  {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "thesis definition [3-35]: the particle count of the genesis"},
+  {"genesis_stress", mat.genesis.stress, unit = "Pa", min = 0, doc = "isotropic stress installed before bonding (scenarios.md 1; model units)"},
+  {"bond_gap", 0, unit = "m", min = 0, doc = "largest gap bonded (0: the engine's default, 1e-3 x mean radius)"},
+  {"wall_friction", 0, min = 0, doc = "of the box walls and the mould during the genesis (scenarios.md 1: frictionless)"},
+  {"seed", 1, type = "integer", min = 0, doc = "of the surface and the packing"},
+  {"pack_steps", 300000, type = "integer", min = 1, doc = "most steps spent cycling the packing towards the ratio 1e-4"},
+  {"record", 0.01, unit = "mm", above = 0, doc = "shear displacement between records"},
+  {"dt_safety", 0, min = 0, max = 1,
+   doc = "time step / critical estimate for closure and shear (0: 1.0 elastic and fracture, 0.8 rigid)"},
+  {"skin", 0, unit = "m", min = 0, doc = "Verlet skin (0: 0.1 mean radius, the rigid model 0.4)"},
+  {"snapshots", "0,1,2.5,5", list = "number", unit = "mm", min = 0,
+   doc = "shear displacements of the particle snapshots (\"\": none)"},
+  {"band", 0, unit = "m", min = 0, doc = "surface vs porosity band (0: mean radius)"},
+  {"out", "out/joint", nonempty = true, doc = "output folder (created when the run starts writing)"},
+  {"cache", "", doc = "folder of cached specimens (\"\": $ASPERITY_CACHE, else ~/.cache/asperity, else out/cache)"},
+  {"threads", 0, type = "integer", min = 0, doc = "0: automatic"},
+  {"simd", "auto", oneof = {"auto", "float", "scalar", "sse4_2", "avx2", "avx512f"},
+   doc = "kernels of closure and shear; float: the force laws in single precision"},
+  {"progress", true, doc = "progress line on the terminal"},
+  {"events_every", 0, type = "integer", min = 0,
+   doc = "steps between energy samples for the event statistics (events.{h5,csv}); 0: none"},
+  {"save", "", doc = "a path: the world's checkpoint when the shear ends"},
+  {"stop_after", "", oneof = {"", "packing"}, doc = "packing: stop once the halves are packed, before bonding"},
+  check = function(P, fail)
+    if P.residual_window >= P.shear then
+      fail("shear", ("must exceed the residual window (residual_window = %g mm): the residual is the "
+                     .. "mean over the last residual_window of the shear"):format(P.residual_window))
+    end
+    if P.record >= P.shear then fail("record", ("must be < shear (%g mm)"):format(P.shear)) end
+    if P.ramp >= P.shear then fail("ramp", ("must be < shear (%g mm)"):format(P.shear)) end
+    for _, s in ipairs(params_lib.split(P.snapshots, true)) do
+      if s > P.shear then fail("snapshots", ("%g mm is beyond shear = %g mm"):format(s, P.shear)) end
+    end
+    -- Constant normal stiffness: a stiffness is what makes it one (0 would be the servo's CNL).
+    if P.normal_control == "stiffness" and not (P.normal_stiffness > 0) then
+      fail("normal_stiffness", "must be > 0 with normal_control=stiffness")
+    elseif P.normal_control ~= "stiffness" and P.normal_stiffness ~= 0 then
+      fail("normal_stiffness", ("needs normal_control=stiffness (now %s)"):format(P.normal_control))
+    end
+    if P.platen >= P.thickness then fail("platen", ("must be < thickness (%g m)"):format(P.thickness)) end
+    local size = (P.scale == "thesis" and params.size == nil) and 0.1 or P.size
+    local cells = size / P.spacing
+    if cells < 2 or cells > 32766 then
+      fail("spacing", ("gives %.0f grid cells over size = %g m; must give 2 .. 32766"):format(cells, size))
+    end
+  end,
 }
-if P.scale == "thesis" then
-  if params.size == nil then P.size = 0.1 end
-elseif P.scale ~= "" then
-  error("scale must be \"thesis\" or empty, got '" .. P.scale .. "'")
-end
-local models = {rigid = true, elastic = true, fracture = true}
-if not models[P.model] then error("model must be rigid, elastic or fracture, got '" .. P.model .. "'") end
-if P.direction ~= "x" and P.direction ~= "y" then error("direction must be x or y") end
-if P.stop_after ~= "" and P.stop_after ~= "packing" then
-  error("stop_after must be \"packing\" or empty, got '" .. P.stop_after .. "'")
-end
-for _, key in ipairs{"quasi_static_limit", "overlap_limit"} do
-  if not (P[key] > 0) then error(("%s must be > 0, got %s"):format(key, tostring(P[key]))) end
-end
--- Constant normal stiffness: a stiffness is what makes it one (0 would be the servo's CNL).
-if P.normal_control == "stiffness" and not (P.normal_stiffness > 0 and P.normal_stiffness < math.huge) then
-  error(("normal_stiffness must be > 0 MPa/mm with normal_control=stiffness, got %s"):format(tostring(P.normal_stiffness)), 0)
-elseif P.normal_control ~= "stiffness" and P.normal_stiffness ~= 0 then
-  error(("normal_stiffness=%s needs normal_control=stiffness (now '%s')"):format(tostring(P.normal_stiffness), P.normal_control), 0)
-end
-if math.type(P.events_every) ~= "integer" or P.events_every < 0 then
-  error(("events_every must be a whole number of steps >= 0 (0: no samples), got %s"):format(tostring(P.events_every)), 0)
+if not P then return end   -- help printed
+if P.scale == "thesis" and params.size == nil then P.size = 0.1 end
+if P.cache == "" then
+  local home = os.getenv("HOME")
+  P.cache = os.getenv("ASPERITY_CACHE") or (os.getenv("XDG_CACHE_HOME") and os.getenv("XDG_CACHE_HOME") .. "/asperity")
+            or (home and home ~= "" and home .. "/.cache/asperity") or (P.out .. "/cache")
 end
 local t_start = asperity.wall_time()
-asperity.mkdir(P.out)
 asperity.mkdir(P.cache)
 local function log(fmt, ...) io.stderr:write(("[joint] " .. fmt .. "\n"):format(...)) end
 
@@ -491,6 +504,9 @@ world:run{steps = 10000000, every = 1, progress = P.progress,
           end}
 record_closure()
 log("closed to %.3g MPa in %.1f um", mpa(normal_stress()), 1e6 * (z_contact - world:group_position(top)[3]))
+-- The output folder appears only now, once every refusal (parameters, the fracture model's
+-- strength check) has had its say: a run that fails to start leaves no empty folder behind.
+asperity.mkdir(P.out)
 closure:write(P.out .. "/closure")
 
 -- Normal stiffness: slope of stress against closure over the upper half of the loading.
@@ -559,7 +575,8 @@ local shear_work, dilatancy_work = 0, 0
 local last_pos, last_force = c0, platen_force()
 local snaps = asperity.snapshots{dir = P.out, name = "joint"}
 local snap_at = {}
-for v in P.snapshots:gmatch("[^,]+") do snap_at[#snap_at + 1] = tonumber(v) end
+for _, v in ipairs(params_lib.split(P.snapshots, true)) do snap_at[#snap_at + 1] = v end
+table.sort(snap_at)
 local next_snap = 1
 local contact_points = {}
 local function displacement() return (c0[axis] - world:group_position(top)[axis]) * 1e3 end
@@ -684,14 +701,14 @@ local cnt = shear:column("contacts")
 local rows = shear:rows()
 local peak, at = -math.huge, 1
 for k = 1, rows do if tau[k] > peak then peak, at = tau[k], k end end
--- Residual: the mean shear stress over the last 0.5 mm, from the platen's impulse (the exact time
+-- Residual: the mean shear stress over the last residual_window mm, from the platen's impulse (the exact time
 -- mean, so it does not depend on the record interval; at constant velocity time and displacement
 -- means agree).
 local residual
 do
   local time = shear:column("time")
   local first = rows
-  while first > 1 and u[first - 1] >= u[rows] - 0.5 do first = first - 1 end
+  while first > 1 and u[first - 1] >= u[rows] - P.residual_window do first = first - 1 end
   if first < rows and time[rows] > time[first] then
     residual = mpa((shear_impulse[rows] - shear_impulse[first]) / (time[rows] - time[first]) / area)
   else
