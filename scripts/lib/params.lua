@@ -130,10 +130,11 @@ local function check_one(script, e, v)
     if type(v) ~= "string" then refuse(script, name, v, "must be " .. allowed(e)) end
     local items, bad = M.split(v, e.list == "number")
     if not items then refuse(script, name, v, ("'%s' is not a number; must be %s"):format(bad, allowed(e))) end
+    local item = {}   -- the bounds of one item, without the list's wording
+    for key, value in pairs(e) do if key ~= "list" then item[key] = value end end
     for _, x in ipairs(items) do
       local why
-      if e.list == "number" then why = out_of_range(e, x)
-      elseif e.oneof then why = out_of_range(e, x) end
+      if e.list == "number" or e.oneof then why = out_of_range(item, x) end
       if why then refuse(script, name, v, ("item %s: %s"):format(show(x), why)) end
     end
     return v
