@@ -386,6 +386,21 @@ local rev = mat.rev
 local stress_scale = mat.rock.young_modulus / rev.young_modulus        -- [3-37]
 local target_stress = P.stress * 1e6 / stress_scale                   -- model units, Pa
 local function mpa(sigma) return sigma * stress_scale / 1e6 end
+-- Units of the stress columns in the HDF5 and CSV files: the model's own Pa, or MPa scaled to the
+-- rock by stress_scale [3-37] (an attribute of every file, with the run's parameters).
+local MODEL_PA, ROCK_MPA = "Pa (model)", "MPa (scaled to rock)"
+local function label_series(series)
+  series:set_attribute("stress_scale", stress_scale)
+  series:set_attribute("stress_units", "columns in '" .. MODEL_PA .. "' are model stresses; columns in '" ..
+                       ROCK_MPA .. "' are model stresses x stress_scale / 1e6")
+  local names = {}
+  for name in pairs(P) do names[#names + 1] = name end
+  table.sort(names)
+  for _, name in ipairs(names) do
+    local v = P[name]
+    series:set_attribute("parameter_" .. name, type(v) == "boolean" and tostring(v) or v)
+  end
+end
 -- Outer faces of the specimen: the lowest point of the lower half, the highest of the upper.
 local zlo, zhi = math.huge, -math.huge
 for _, id in ipairs(lower) do zlo = math.min(zlo, pos[id][3]) end
@@ -452,6 +467,16 @@ else
 end
 
 local bonds_at_start = world:bond_count()
+-- Particle snapshots (HDF5 + XDMF) indexed by `label` (the shear or the closure displacement in
+-- mm), with the keys of the integer fields; the particles left out of the specimen are not
+-- written, so they are not drawn as debris between the halves.
+local function joint_snapshots(name, label)
+  local groups = P.model == "rigid" and ("%d: lower half (rigid), %d: upper half (rigid), -1: none")
+                 or ("%d: lower platen, %d: upper platen, -1: none (bonded particles)")
+  return asperity.snapshots{dir = P.out, name = name, time = label, exclude_tag = LOST,
+                            keys = {group = groups:format(bottom, top),
+                                    tag = ("%d: lower half, %d: upper half"):format(LOWER, UPPER)}}
+end
 
 -- 5. Assembly: bring the halves together until exactly one contact exists [4.2.1] ------------
 local function between() return world:contact_summary(LOWER, UPPER, POROSITY) end
@@ -463,8 +488,14 @@ log("halves in contact after %d steps", steps)
 
 -- 6. Closure at constant velocity to the normal stress [thesis 4.2.2] -----------------------
 local z_contact = world:group_position(top)[3]
-local closure = asperity.series{"closure [m]", "closure_corrected [m]", "normal_stress [Pa]",
-  "normal_stress_mpa [MPa]", "contacts [1]", "contact_area [%]", "broken_bonds [1]", "time [s]"}
+-- The output folder appears only now, once every refusal (parameters, the fracture model's
+-- strength check) has had its say: a run that fails to start leaves no empty folder behind.
+asperity.mkdir(P.out)
+local function closure_mm() return 1e3 * (z_contact - world:group_position(top)[3]) end
+local closure_snaps = joint_snapshots("joint_closure", "closure (mm)")
+closure_snaps:write(world, {stage = "closure", closure_mm = 0}, 0)
+local closure = asperity.series{"closure [mm]", "closure_corrected [mm]", "normal_stress [" .. MODEL_PA .. "]",
+  "normal_stress_mpa [" .. ROCK_MPA .. "]", "contacts [1]", "contact_area [%]", "broken_bonds [1]", "time [s]"}
 local height = zhi - zlo
 -- Force of the particles on the upper platen (the group force less any applied dead load).
 local applied_z = 0
@@ -488,7 +519,7 @@ local function record_closure()
   local s = normal_stress()
   local c = between()
   local d = z_contact - world:group_position(top)[3]
-  closure:record(d, d - s * height / rev.young_modulus, s, mpa(s), c.count,
+  closure:record(1e3 * d, 1e3 * (d - s * height / rev.young_modulus), s, mpa(s), c.count,
                  100 * c.area / area, world:break_count(), world:time())
 end
 world:set_group_motion(top, {velocity = {0, 0, -P.closure_velocity}})
@@ -504,9 +535,8 @@ world:run{steps = 10000000, every = 1, progress = P.progress,
           end}
 record_closure()
 log("closed to %.3g MPa in %.1f um", mpa(normal_stress()), 1e6 * (z_contact - world:group_position(top)[3]))
--- The output folder appears only now, once every refusal (parameters, the fracture model's
--- strength check) has had its say: a run that fails to start leaves no empty folder behind.
-asperity.mkdir(P.out)
+closure_snaps:write(world, {stage = "closure", closure_mm = closure_mm()}, closure_mm())
+label_series(closure)
 closure:write(P.out .. "/closure")
 
 -- Normal stiffness: slope of stress against closure over the upper half of the loading.
@@ -519,7 +549,7 @@ end
 local cd, cs = closure:column("closure"), closure:column("normal_stress_mpa")
 local kx, ky = {}, {}
 for k = 1, closure:rows() do
-  if cs[k] >= 0.5 * P.stress then kx[#kx + 1] = cd[k] * 1e3; ky[#ky + 1] = cs[k] end
+  if cs[k] >= 0.5 * P.stress then kx[#kx + 1] = cd[k]; ky[#ky + 1] = cs[k] end
 end
 local normal_stiffness = fit(kx, ky)   -- MPa/mm
 
@@ -564,21 +594,30 @@ do
             end}
   log("settled on the normal load in %d steps", n)
 end
-local shear = asperity.series{"displacement [mm]", "shear_stress [Pa]", "shear_stress_mpa [MPa]",
-  "normal_stress_mpa [MPa]", "normal_stress_mean_mpa [MPa]", "dilatancy [mm]", "contacts [1]", "contact_area [%]",
-  "broken_bonds [1]", "porosity_shear_stress_mpa [MPa]", "kinetic [J]", "strain [J]",
+local shear = asperity.series{"displacement [mm]", "shear_stress [" .. MODEL_PA .. "]", "shear_stress_mpa [" .. ROCK_MPA .. "]",
+  "normal_stress_mpa [" .. ROCK_MPA .. "]", "normal_stress_mean_mpa [" .. ROCK_MPA .. "]", "dilatancy [mm]", "contacts [1]", "contact_area [%]",
+  "broken_bonds [1]", "porosity_shear_stress_mpa [" .. ROCK_MPA .. "]", "kinetic [J]", "strain [J]",
   "friction [J]", "damping [J]", "released [J]", "boundary_work [J]", "shear_work [J]",
   "dilatancy_work [J]", "time [s]"}
 local c0 = world:group_position(top)
 local e0 = world:energies()
 local shear_work, dilatancy_work = 0, 0
 local last_pos, last_force = c0, platen_force()
-local snaps = asperity.snapshots{dir = P.out, name = "joint"}
+local snaps = joint_snapshots("joint", "shear displacement (mm)")
 local snap_at = {}
 for _, v in ipairs(params_lib.split(P.snapshots, true)) do snap_at[#snap_at + 1] = v end
 table.sort(snap_at)
 local next_snap = 1
-local contact_points = {}
+-- The contact points between the halves at the highest shear stress so far: at the end, those of
+-- the peak (for its contact map).
+local peak_seen, peak_points = -math.huge, nil
+local function points_between()
+  local pts = {}
+  for _, ct in ipairs(world:contacts()) do
+    if world:tag(ct.a) ~= world:tag(ct.b) then pts[#pts + 1] = {ct.point[1], ct.point[2]} end
+  end
+  return pts
+end
 local function displacement() return (c0[axis] - world:group_position(top)[axis]) * 1e3 end
 -- The normal stress averaged over each recording interval, as a load cell with a low-pass filter
 -- reads it (the instantaneous value also carries the platen's inertia at each slip event of the
@@ -611,13 +650,11 @@ local function record_shear()
                e.kinetic, e.strain - e0.strain, e.friction - e0.friction, e.damping - e0.damping,
                e.released - e0.released, e.boundary_work - e0.boundary_work, shear_work,
                dilatancy_work, world:time())
+  if mpa(tau) > peak_seen then
+    peak_seen, peak_points = mpa(tau), {at = displacement(), step = world:step(), points = points_between()}
+  end
   while next_snap <= #snap_at and displacement() >= snap_at[next_snap] - 1e-9 do
-    snaps:write(world)
-    local pts = {}
-    for _, ct in ipairs(world:contacts()) do
-      if world:tag(ct.a) ~= world:tag(ct.b) then pts[#pts + 1] = {ct.point[1], ct.point[2]} end
-    end
-    contact_points[#contact_points + 1] = {at = snap_at[next_snap], points = pts}
+    snaps:write(world, {stage = "shear", shear_displacement_mm = displacement()}, displacement())
     next_snap = next_snap + 1
   end
 end
@@ -678,6 +715,7 @@ if P.save ~= "" then
 end
 local shear_seconds, shear_steps = asperity.wall_time() - shear_t0, world:step() - shear_s0
 local shear_rebuilds = world:stats().rebuilds - shear_r0
+label_series(shear)
 shear:write(P.out .. "/shear")
 if events then events:write(P.out .. "/events") end
 -- Every bond break while shearing (model.md 5), for the event statistics and maps.
@@ -795,9 +833,20 @@ local summary = {
   bonds = world:bond_count(),
   stress_scale = stress_scale,
   target_stress_pa = target_stress,
+  stress_units = "*_mpa: MPa scaled to rock (model Pa x stress_scale / 1e6); *_pa: model Pa",
+  -- The shear stress of the first record, before the platen moves: the lateral force the held
+  -- platen carries once the closure is done (the normal load on inclined asperity contacts pushes
+  -- the halves sideways). The shear curve starts from it.
+  shear_stress_at_start_mpa = tau[1],
+  closure_mm = closure:column("closure")[closure:rows()],
   peak_shear_stress_mpa = peak,
   peak_displacement_mm = u[at],
   residual_shear_stress_mpa = residual,
+  -- the reference study's values for this surface, model and stress, where it has them
+  reference = P.surface_file == "" and require("reference").joint(P.surface, P.model, P.stress) or nil,
+  residual_window_mm = P.residual_window,    -- the residual: the mean over the last this much shear
+  peak_friction = peak / P.stress,           -- tau / sigma_n at the peak
+  residual_friction = residual / P.stress,
   kinetic_ratio_max = dynamic_ratio,         -- max Ek / (normal load x mean radius) while shearing
   kinetic_ratio_max_at_mm = dynamic_at,
   quasi_static = dynamic_ratio <= P.quasi_static_limit,
@@ -839,49 +888,53 @@ local summary = {
 asperity.write_json(P.out .. "/summary.json", summary)
 
 -- 9. Plots ----------------------------------------------------------------------------------
-pcall(function()
-  local title = ("%s, %s model, %g MPa, shear along -%s"):format(P.surface, P.model, P.stress, P.direction)
-  shear:plot{file = P.out .. "/shear_stress.png", x = "displacement", y = {"shear_stress_mpa"}, title = title}
-  shear:plot{file = P.out .. "/dilatancy.png", x = "displacement", y = {"dilatancy"}, title = title}
-  shear:plot{file = P.out .. "/contacts.png", x = "displacement", y = {"contacts"}, title = title}
-  shear:plot{file = P.out .. "/broken_bonds.png", x = "displacement", y = {"broken_bonds"}, title = title}
-  shear:plot{file = P.out .. "/energies.png", x = "displacement",
-             y = {"boundary_work", "friction", "damping", "strain", "released"}, title = title}
-  closure:plot{file = P.out .. "/closure.png", x = "closure", y = {"normal_stress_mpa"}, title = title}
+local plotted, plot_error = pcall(function()
+  local jf = require("joint_figures")
+  local ref = require("reference")
+  local surface_name = P.surface_file ~= "" and P.surface_file:match("[^/]*$") or P.surface
+  local title = ("%s, %s model, %g MPa normal stress, shear along -%s (%d particles)"):format(
+    surface_name, P.model, P.stress, P.direction, #lower + #upper)
+  local res_from = u[rows] - P.residual_window
+  jf.shear{file = P.out .. "/shear_stress.png", title = title, u = u, tau = tau, dilatancy = dil,
+           peak = {at = u[at], value = peak}, residual = {value = residual, from = res_from, to = u[rows]},
+           reference = P.surface_file == "" and ref.joint(P.surface, P.model, P.stress) or nil}
+  jf.cnl{file = P.out .. "/normal_stress.png", title = title .. ": constant normal load", u = u, tau = tau,
+         sn = sn, sn_mean = sn_mean, target = P.stress, reference = ref.ratios(P.model, P.stress)}
+  jf.closure{file = P.out .. "/closure.png", title = title .. ": closure", closure = closure:column("closure"),
+             sn = closure:column("normal_stress_mpa"), target = P.stress, stiffness = normal_stiffness}
+  local peak_mark = {at = u[at], label = "peak"}
+  jf.curves{file = P.out .. "/contacts.png", title = title, x = u, mark = peak_mark,
+            ylabel = "contacts between the halves", curves = {{cnt}}}
+  jf.curves{file = P.out .. "/broken_bonds.png", title = title, x = u, mark = peak_mark,
+            ylabel = "broken bonds (since the shear began)", curves = {{shear:column("broken_bonds")}}}
+  local function col(name) return shear:column(name) end
+  jf.curves{file = P.out .. "/energies.png", title = title .. ": energy since the shear began", x = u,
+            ylabel = "energy (J, model units)",
+            curves = {{col("boundary_work"), "work done by the platens"}, {col("friction"), "dissipated by friction"},
+                      {col("damping"), "dissipated by damping"}, {col("strain"), "stored in contacts and bonds"},
+                      {col("released"), "released by broken bonds"}, {col("kinetic"), "kinetic"}}}
 end)
--- Contact points at the last snapshot and broken bonds over the elevation map.
+if not plotted then log("plots skipped: %s", tostring(plot_error)) end
+-- Contact points and broken bonds over the elevation map, at the peak and at the end.
 pcall(function()
-  local pts = contact_points[#contact_points]
-  local data = os.tmpname()
-  local fh = assert(io.open(data, "w"))
-  for j = 1, ny do
-    for i = 1, nx do fh:write(("%.6g %.6g %.6g\n"):format((i - 1) * h * 1e3, (j - 1) * h * 1e3, heights[(j - 1) * nx + i] * 1e3)) end
-    fh:write("\n")
+  local jf = require("joint_figures")
+  local events = world:break_events()
+  local function broken_until(step)
+    local pts = {}
+    for _, ev in ipairs(events) do
+      if not step or ev.step <= step then pts[#pts + 1] = {ev.position[1], ev.position[2]} end
+    end
+    return pts
   end
-  fh:write("\n\n")
-  if pts then for _, p in ipairs(pts.points) do fh:write(("%.6g %.6g 0\n"):format(p[1] * 1e3, p[2] * 1e3)) end end
-  fh:write("NaN NaN NaN\n\n\n")
-  for _, ev in ipairs(world:break_events()) do
-    fh:write(("%.6g %.6g 0\n"):format(ev.position[1] * 1e3, ev.position[2] * 1e3))
+  local label = ("%s, %s model, %g MPa"):format(P.surface, P.model, P.stress)
+  if peak_points then
+    jf.contact_map{file = P.out .. "/contact_map_peak.png", nx = nx, ny = ny, h = h, heights = heights,
+                   points = peak_points.points, broken = broken_until(peak_points.step),
+                   title = ("%s: at the peak, %.2f mm of shear"):format(label, peak_points.at)}
   end
-  fh:write("NaN NaN NaN\n")
-  fh:close()
-  local script = os.tmpname()
-  local gp = assert(io.open(script, "w"))
-  gp:write(([[set terminal pngcairo noenhanced size 900,800
-set output "%s"
-set title "%s: contacts between the halves at %s mm (black), broken bonds (white)"
-set xlabel "x [mm]"
-set ylabel "y [mm]"
-set cblabel "elevation [mm]"
-set size ratio -1
-set view map
-plot "%s" index 0 using 1:2:3 with image notitle, "%s" index 1 using 1:2 with points pt 7 ps 0.6 lc rgb "black" title "contacts", "%s" index 2 using 1:2 with points pt 6 ps 0.6 lc rgb "white" title "broken bonds"
-]]):format(P.out .. "/contact_map.png", P.surface, pts and tostring(pts.at) or "?", data, data, data))
-  gp:close()
-  os.execute("gnuplot " .. script .. " 2>/dev/null")
-  os.remove(script)
-  os.remove(data)
+  jf.contact_map{file = P.out .. "/contact_map.png", nx = nx, ny = ny, h = h, heights = heights,
+                 points = points_between(), broken = broken_until(nil),
+                 title = ("%s: at the end, %.2f mm of shear"):format(label, displacement())}
 end)
 
 print(("%s %s %g MPa -%s: %d particles, peak %.2f MPa at %.2f mm, residual %.2f MPa, " ..
