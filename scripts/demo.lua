@@ -63,8 +63,10 @@ snaps:write(world)
 energy:write(P.out .. "/energy")
 local plotted = pcall(function()
   energy:plot{file = P.out .. "/energy.png", x = "time", y = {"kinetic"}, logy = true,
-              title = ("%d spheres settling"):format(P.n)}
-  energy:plot{file = P.out .. "/ratio.png", x = "time", y = {"unbalanced_ratio"}, logy = true}
+              title = ("%d spheres settling"):format(P.n), xlabel = "time (s)", ylabel = "kinetic energy (J)"}
+  energy:plot{file = P.out .. "/ratio.png", x = "time", y = {"unbalanced_ratio"}, logy = true,
+              title = ("%d spheres settling"):format(P.n), xlabel = "time (s)",
+              ylabel = "mean unbalanced force / mean contact force"}
 end)
 
 local _, _, ztop = world:positions():max()
