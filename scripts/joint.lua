@@ -493,7 +493,7 @@ local z_contact = world:group_position(top)[3]
 asperity.mkdir(P.out)
 local function closure_mm() return 1e3 * (z_contact - world:group_position(top)[3]) end
 local closure_snaps = joint_snapshots("joint_closure", "closure (mm)")
-closure_snaps:write(world, {stage = "closure", closure_mm = 0}, 0)
+closure_snaps:write(world, {stage = "closure", closure_mm = 0, stress_scale = stress_scale}, 0)
 local closure = asperity.series{"closure [mm]", "closure_corrected [mm]", "normal_stress [" .. MODEL_PA .. "]",
   "normal_stress_mpa [" .. ROCK_MPA .. "]", "contacts [1]", "contact_area [%]", "broken_bonds [1]", "time [s]"}
 local height = zhi - zlo
@@ -535,7 +535,7 @@ world:run{steps = 10000000, every = 1, progress = P.progress,
           end}
 record_closure()
 log("closed to %.3g MPa in %.1f um", mpa(normal_stress()), 1e6 * (z_contact - world:group_position(top)[3]))
-closure_snaps:write(world, {stage = "closure", closure_mm = closure_mm()}, closure_mm())
+closure_snaps:write(world, {stage = "closure", closure_mm = closure_mm(), stress_scale = stress_scale}, closure_mm())
 label_series(closure)
 closure:write(P.out .. "/closure")
 
@@ -654,7 +654,7 @@ local function record_shear()
     peak_seen, peak_points = mpa(tau), {at = displacement(), step = world:step(), points = points_between()}
   end
   while next_snap <= #snap_at and displacement() >= snap_at[next_snap] - 1e-9 do
-    snaps:write(world, {stage = "shear", shear_displacement_mm = displacement()}, displacement())
+    snaps:write(world, {stage = "shear", shear_displacement_mm = displacement(), stress_scale = stress_scale}, displacement())
     next_snap = next_snap + 1
   end
 end

@@ -249,10 +249,10 @@ end
 
 -- One test from a checkpoint: the top platen moves at `velocity`; rows every P.every steps;
 -- `stop(row, peak)` ends it. slab = true also records the mean stress tensor of the middle slab.
-local columns = {"step", "time [s]", "displacement [m]", "axial_stress [Pa]", "shear_stress [Pa]",
+local columns = {"step", "time [s]", "displacement [m]", "axial_stress [Pa (model)]", "shear_stress [Pa (model)]",
                  "axial_strain", "lateral_strain", "strain_x", "strain_y", "shear_strain",
-                 "shear_strain_layers", "broken_bonds", "slab_xx [Pa]", "slab_yy [Pa]", "slab_zz [Pa]",
-                 "slab_xz [Pa]", "slab_zx [Pa]"}
+                 "shear_strain_layers", "broken_bonds", "slab_xx [Pa (model)]", "slab_yy [Pa (model)]", "slab_zz [Pa (model)]",
+                 "slab_xz [Pa (model)]", "slab_zx [Pa (model)]"}
 local function run_test(checkpoint, name, velocity, o)
   local t0 = asperity.wall_time()
   local platens, gauges = rigs[checkpoint].platens, rigs[checkpoint].gauges
@@ -403,7 +403,7 @@ local fracture
 local function break_map(w, name, title)
   local events = w:break_events()
   local f = assert(io.open(out .. "/" .. name .. "_breaks.csv", "w"))
-  f:write("step,time [s],x [m],y [m],z [m],a,b,mode,sigma [Pa],tau [Pa],released_energy [J]\n")
+  f:write("step,time [s],x [m],y [m],z [m],a,b,mode,sigma [Pa (model)],tau [Pa (model)],released_energy [J]\n")
   local modes = {tension = 1, shear = 2, compression = 3}
   local pts = {}
   for _, e in ipairs(events) do
