@@ -78,7 +78,7 @@ local P = params_lib.parse{
   {"rotation_lock_bonds", rev.rotation_lock_bonds, type = "integer", min = 1,
    doc = "... while they hold at least this many intact bonds"},
   {"bond_gap", 0, unit = "m", min = 0, doc = "largest gap bonded (0: the engine's default, 1e-3 x mean radius)"},
-  {"dt_safety", 0, min = 0, max = 1, doc = "time step / critical estimate in the tests (0: the engine's 0.8)"},
+  {"dt_safety", 0, min = 0, max = 2, doc = "time step / critical estimate in the tests (0: the engine's 0.8; above 1 only to study instability)"},
   {"cache", "", doc = "a folder: the packing is cached there and reused (calibrate_rev.lua)"},
   {"threads", 1, type = "integer", min = 0, doc = "0: automatic"},
   {"simd", "auto", oneof = {"auto", "float", "scalar", "sse4_2", "avx2", "avx512f"},
