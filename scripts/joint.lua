@@ -19,9 +19,13 @@
 -- The halves are made by the REV's genesis (lib/genesis.lua), so they are the calibrated
 -- material. Stresses are reported in model units and scaled to rock [3-37].
 --
--- Writes into `out`: summary.json; closure.{h5,csv}, shear.{h5,csv}; snapshots (HDF5 + XDMF) at
--- the displacements in `snapshots`; PNG plots: shear stress and dilatancy, closure curve, contact
--- count, broken bonds, energies, and maps of contact points and broken bonds over the elevation.
+-- Writes into `out` (created once every check has passed): summary.json; closure.{h5,csv},
+-- shear.{h5,csv} (stresses in model Pa and in MPa scaled to rock, closure and displacements in
+-- mm; the stress scale and the parameters as attributes); snapshots joint.xdmf (XDMF time = shear
+-- displacement, mm) at the displacements in `snapshots` and joint_closure.xdmf (closure, mm);
+-- PNG plots: shear stress and dilatancy, normal stress and tau / sigma_n, closure curve, contact
+-- count, broken bonds, energies, and maps of contact points and broken bonds over the elevation
+-- at the peak and at the end. `--help` lists the parameters.
 local mat = require("materials")
 local radii_lib = require("radii")
 local genesis = require("genesis")
