@@ -908,9 +908,9 @@ local plotted, plot_error = pcall(function()
              sn = closure:column("normal_stress_mpa"), target = P.stress, stiffness = normal_stiffness}
   local peak_mark = {at = u[at], label = "peak"}
   jf.curves{file = P.out .. "/contacts.png", title = title, x = u, mark = peak_mark,
-            ylabel = "contacts between the halves", curves = {{cnt}}}
+            ylabel = "contacts between the halves", curves = {{cnt}}, from_zero = true}
   jf.curves{file = P.out .. "/broken_bonds.png", title = title, x = u, mark = peak_mark,
-            ylabel = "broken bonds (since the shear began)", curves = {{shear:column("broken_bonds")}}}
+            ylabel = "broken bonds", curves = {{shear:column("broken_bonds")}}, from_zero = true}
   local function col(name) return shear:column(name) end
   jf.curves{file = P.out .. "/energies.png", title = title .. ": energy since the shear began", x = u,
             ylabel = "energy (J, model units)",

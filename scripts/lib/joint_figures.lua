@@ -136,7 +136,7 @@ function M.closure(o)
 end
 
 -- One panel of curves against shear displacement: {x = {...}, curves = {{values, title}, ...}}.
--- A single curve has no key.
+-- A single curve has no key; from_zero: the y axis starts at 0.
 function M.curves(o)
   local cols = {o.x}
   for _, c in ipairs(o.curves) do cols[#cols + 1] = c[1] end
@@ -146,6 +146,17 @@ function M.curves(o)
                  single and "set lmargin at screen 0.09\nset rmargin at screen 0.95\nunset key\n" or panel(0.90, 0.12),
                  ("set xrange [0:%.10g]\n"):format(o.x[#o.x]),
                  ("set xlabel %s\nset ylabel %s\n"):format(quote(o.xlabel or "shear displacement (mm)"), quote(o.ylabel))}
+  if o.from_zero then   -- counts: from 0 (and a unit range when all are 0)
+    local top = 0
+    for _, c in ipairs(o.curves) do
+      local values = c[1]   -- a table or an asperity Array (which has no end marker for ipairs)
+      for i = 1, #values do
+        local v = values[i]
+        if v == v then top = math.max(top, v) end
+      end
+    end
+    lines[#lines + 1] = top > 0 and "set yrange [0:*]\n" or "set yrange [0:1]\n"
+  end
   if o.mark then
     lines[#lines + 1] = ("set arrow 1 from %.10g, graph 0 to %.10g, graph 1 nohead dt 2 lw 1.5 lc rgb %s\n"):format(
       o.mark.at, o.mark.at, quote(RED))
@@ -185,7 +196,7 @@ function M.contact_map(o)
      "set size ratio -1\nset view map\nset xrange [0:%.6g]\nset yrange [0:%.6g]\nunset grid\n" ..
      "set key outside below horizontal\nset palette defined (0 \"#f0f0f0\", 1 \"#909090\", 2 \"#303030\")\n" ..
      "plot %s index 0 using 1:2:3 with image notitle, \\\n" ..
-     "  %s index 1 using 1:2 with points pt 7 ps 0.7 lc rgb %s title %s, \\\n" ..
+     "  %s index 1 using 1:2 with points pt 7 ps 1.1 lc rgb %s title %s, \\\n" ..
      "  %s index 2 using 1:2 with points pt 6 ps 0.8 lc rgb %s title %s\nunset output\n"):format(
       quote(o.title or ""), extent_x, extent_y, quote(name), quote(name), quote(RED),
       quote(("contacts between the halves (%d)"):format(#(o.points or {}))), quote(name), quote(BLUE),
