@@ -21,7 +21,12 @@
 --   list     "number" or "string": a comma-separated list (a string; "" is the empty list),
 --            each item checked against the bounds or `oneof`
 --   file     true: a path that must be readable (when not "")
+--   nonempty true: "" is refused (output folders)
 --   doc      one line for the help
+-- The spec's own fields: script (the name errors start with), path (for the usage line), about
+-- (one line), notes (printed after the table), check (below). Defaults are not checked here:
+-- tests/scenarios/params.lua runs every script with its defaults and with values each
+-- declaration forbids.
 -- Numbers must be finite. The spec's `check(P, fail)` runs after every single value passed, for
 -- rules between parameters; fail(name, message) refuses one of them.
 --
