@@ -97,9 +97,22 @@ for _, script in ipairs{"joint.lua", "rev.lua", "calibrate_rev.lua", "surface.lu
   -- The defaults pass their own checks: the script gets to its first piece of work.
   local ok, err = run(script, {})
   assert(not ok and tostring(err):find(WORK, 1, true), script .. ": the defaults are refused: " .. tostring(err))
-  -- help=true prints the table and stops before any work.
+  -- help=true prints the table and stops before any work: every parameter with its default,
+  -- its unit and what is allowed.
+  local printed = {}
+  local write = io.write
+  io.write = function(...) for _, s in ipairs{...} do printed[#printed + 1] = tostring(s) end end
   ok, err = run(script, {help = true})
+  io.write = write
   assert(ok, script .. ": help=true failed: " .. tostring(err))
+  local text = table.concat(printed)
+  for _, e in ipairs(spec) do
+    local line = text:match("\n  (" .. e[1]:gsub("%p", "%%%0") .. "=[^\n]*)")
+    assert(line, script .. ": the help does not list " .. e[1])
+    if e.unit then assert(line:find(e.unit, 1, true), script .. ": the help gives no unit for " .. e[1]) end
+    local a = lib.allowed(e)
+    if a ~= "" then assert(line:find(a, 1, true), script .. ": the help does not say what " .. e[1] .. " allows") end
+  end
   for _, e in ipairs(spec) do
     local values = bad_values(e)
     if #values == 0 then skipped[#skipped + 1] = script .. ":" .. e[1] end
