@@ -240,6 +240,20 @@ function M.parse(spec, given)
   return P
 end
 
+-- Runs another script with these parameters, as a study runs joint.lua for each case, and returns
+-- what the script returns (its summary). The caller's own `params` are put back afterwards, also
+-- when the script fails (its error, a refusal included, goes on to the caller).
+--   local s = require("params").run("joint.lua", {surface = "S5", stress = 21, out = "out/s5"})
+function M.run(script, given)
+  local path = script:find("/", 1, true) and script or (asperity.scripts_dir .. "/" .. script)
+  local saved = params
+  params = given or {}
+  local result = table.pack(pcall(dofile, path))
+  params = saved
+  if not result[1] then error(result[2], 0) end
+  return table.unpack(result, 2, result.n)
+end
+
 -- The older form: defaults only, each value must have the type of its default.
 --   local P = require("params").defaults{n = 400, out = "out/demo"}
 function M.defaults(defaults, given)

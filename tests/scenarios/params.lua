@@ -150,6 +150,16 @@ for _, v in ipairs{"0,1", 1, "0, 0.5 ,1"} do
   assert(not ok and tostring(err):find(WORK, 1, true), ("snapshots=%s refused: %s"):format(show(v), tostring(err)))
 end
 
+-- params.run: another script with its own parameters; the caller's come back, and a refusal
+-- reaches the caller as the same object.
+params = {mine = true}
+local ok, err = pcall(lib.run, "demo.lua", {n = 0})
+assert(not ok and getmetatable(err) == lib.Refusal and tostring(err):find("parameter n=0", 1, true),
+       "params.run passes the refusal on: " .. tostring(err))
+assert(params.mine == true, "params.run restores the caller's params")
+ok, err = pcall(lib.run, "demo.lua", {help = true})
+assert(ok and params.mine == true, "params.run with help: " .. tostring(err))
+
 print(("%d bad values refused by name; parameters without a forbidden value (free paths): %s"):format(
   checked, table.concat(skipped, ", ")))
 print("PASS")
