@@ -80,7 +80,8 @@ local P = params_lib.parse{
    doc = "time step / critical estimate for closure and shear (0: 1.0 elastic and fracture, 0.8 rigid; above 1 only to study instability)"},
   {"skin", 0, unit = "m", min = 0, doc = "Verlet skin (0: 0.1 mean radius, the rigid model 0.4)"},
   {"snapshots", "0,1,2.5,5", list = "number", unit = "mm", min = 0,
-   doc = "shear displacements of the particle snapshots (\"\": none)"},
+   doc = "shear displacements of the particle snapshots, within 0 .. shear (\"\": none; by default those "
+         .. "within a shorter shear and its end)"},
   {"band", 0, unit = "m", min = 0, doc = "surface vs porosity band (0: mean radius)"},
   {"out", "out/joint", nonempty = true, doc = "output folder (created when the run starts writing)"},
   {"cache", "", doc = "folder of cached specimens (\"\": $ASPERITY_CACHE, else ~/.cache/asperity, else out/cache)"},
@@ -92,15 +93,25 @@ local P = params_lib.parse{
    doc = "steps between energy samples for the event statistics (events.{h5,csv}); 0: none"},
   {"save", "", doc = "a path: the world's checkpoint when the shear ends"},
   {"stop_after", "", oneof = {"", "packing"}, doc = "packing: stop once the halves are packed, before bonding"},
-  check = function(P, fail)
+  check = function(P, fail, given)
     if P.residual_window >= P.shear then
       fail("shear", ("must exceed the residual window (residual_window = %g mm): the residual is the "
                      .. "mean over the last residual_window of the shear"):format(P.residual_window))
     end
     if P.record >= P.shear then fail("record", ("must be < shear (%g mm)"):format(P.shear)) end
     if P.ramp >= P.shear then fail("ramp", ("must be < shear (%g mm)"):format(P.shear)) end
-    for _, s in ipairs(params_lib.split(P.snapshots, true)) do
-      if s > P.shear then fail("snapshots", ("%g mm is beyond shear = %g mm"):format(s, P.shear)) end
+    if given.snapshots ~= nil then
+      for _, s in ipairs(params_lib.split(P.snapshots, true)) do
+        if s > P.shear then fail("snapshots", ("%g mm is beyond shear = %g mm"):format(s, P.shear)) end
+      end
+    else
+      -- the default list follows a shorter shear: the displacements within it, and its end
+      local kept = {}
+      for _, s in ipairs(params_lib.split(P.snapshots, true)) do
+        if s < P.shear then kept[#kept + 1] = ("%g"):format(s) end
+      end
+      kept[#kept + 1] = ("%g"):format(P.shear)
+      P.snapshots = table.concat(kept, ",")
     end
     -- Constant normal stiffness: a stiffness is what makes it one (0 would be the servo's CNL).
     if P.normal_control == "stiffness" and not (P.normal_stiffness > 0) then

@@ -27,8 +27,10 @@
 -- (one line), notes (printed after the table), check (below). Defaults are not checked here:
 -- tests/scenarios/params.lua runs every script with its defaults and with values each
 -- declaration forbids.
--- Numbers must be finite. The spec's `check(P, fail)` runs after every single value passed, for
--- rules between parameters; fail(name, message) refuses one of them.
+-- Numbers must be finite. The spec's `check(P, fail, given)` runs after every single value
+-- passed, for rules between parameters; fail(name, message) refuses one of them, and `given`
+-- (the values as given) tells a default from a value the user chose, so a default may adapt to
+-- the others where a given value would be refused.
 --
 -- Errors read "<script>: parameter NAME=VALUE: <what is allowed>" and carry no Lua position
 -- (the position of the check inside this file would tell the user nothing).
@@ -235,7 +237,7 @@ function M.parse(spec, given)
     if v == nil then P[e[1]] = e[2] else P[e[1]] = check_one(script, e, v) end
   end
   if spec.check then
-    spec.check(P, function(name, message) refuse(script, name, P[name], message) end)
+    spec.check(P, function(name, message) refuse(script, name, P[name], message) end, given)
   end
   return P
 end

@@ -144,6 +144,18 @@ expect_refusal("rev.lua", {platen = 0.006}, "platen", "size / 2")
 expect_refusal("rev.lua", {radius_sd = 0.2e-3}, "radius_sd", "3 SD")
 expect_refusal("rev.lua", {tests = ""}, "tests", "at least one")
 expect_refusal("surface.lua", {n = 128}, "n", "odd")
+-- The default snapshots follow a shorter shear (those within it and its end); given ones do not.
+do
+  local parse, seen = lib.parse, nil
+  lib.parse = function(spec, given) seen = parse(spec, given); return seen end
+  run("joint.lua", {shear = 1})
+  assert(seen.snapshots == "0,1", "default snapshots for shear=1: " .. tostring(seen.snapshots))
+  run("joint.lua", {shear = 2})
+  assert(seen.snapshots == "0,1,2", "default snapshots for shear=2: " .. tostring(seen.snapshots))
+  run("joint.lua", {})
+  assert(seen.snapshots == "0,1,2.5,5", "default snapshots for the default shear: " .. tostring(seen.snapshots))
+  lib.parse = parse
+end
 -- A value typed on the command line arrives as a string or a number; both forms of a list pass.
 for _, v in ipairs{"0,1", 1, "0, 0.5 ,1"} do
   local ok, err = run("joint.lua", {snapshots = v, shear = 1})
