@@ -913,8 +913,16 @@ local plotted, plot_error = pcall(function()
   jf.shear{file = P.out .. "/shear_stress.png", title = title, u = u, tau = tau, dilatancy = dil,
            peak = {at = u[at], value = peak}, residual = {value = residual, from = res_from, to = u[rows]},
            reference = P.surface_file == "" and ref.joint(P.surface, P.model, P.stress) or nil}
-  jf.cnl{file = P.out .. "/normal_stress.png", title = title .. ": constant normal load", u = u, tau = tau,
-         sn = sn, sn_mean = sn_mean, target = P.stress, reference = ref.ratios(P.model, P.stress)}
+  local cns = P.normal_control == "stiffness"
+  local asked
+  if cns then
+    asked = {}
+    for k = 1, rows do asked[k] = P.stress + P.normal_stiffness * dil[k] end
+  end
+  jf.cnl{file = P.out .. "/normal_stress.png", title = title .. (cns and ": constant normal stiffness" or ": constant normal load"),
+         u = u, tau = tau, sn = sn, sn_mean = sn_mean, target = P.stress, target_values = asked,
+         target_label = cns and ("target %g MPa + %g MPa/mm x dilatancy"):format(P.stress, P.normal_stiffness) or nil,
+         reference = not cns and ref.ratios(P.model, P.stress) or nil}
   jf.closure{file = P.out .. "/closure.png", title = title .. ": closure", closure = closure:column("closure"),
              sn = closure:column("normal_stress_mpa"), target = P.stress, stiffness = normal_stiffness}
   local peak_mark = {at = u[at], label = "peak"}

@@ -87,23 +87,27 @@ function M.shear(o)
 end
 
 -- The constant-normal-load check: the normal stress held on the joint and the mobilised
--- friction tau / sigma_n, against shear displacement.
+-- friction tau / sigma_n, against shear displacement. target: the normal stress asked for, or
+-- target_values (one per record, with target_label) when it follows the dilatancy.
 function M.cnl(o)
   local ratio = {}
   for i = 1, #o.u do
     local sn = o.sn_mean[i]
     ratio[i] = (sn and sn > 0) and o.tau[i] / sn or 0 / 0
   end
-  local d = data_file{o.u, o.sn, o.sn_mean, ratio}
+  -- the stress the control asks for: constant, or (constant normal stiffness) one per record
+  local target = o.target_values or {}
+  if not o.target_values then for i = 1, #o.u do target[i] = o.target end end
+  local d = data_file{o.u, o.sn, o.sn_mean, ratio, target}
   local lines = {HEAD:format(1250, 900, quote(o.file)), ("set multiplot title %s\n"):format(quote(o.title or "")),
                  ("set xrange [0:%.10g]\n"):format(o.u[#o.u])}
   lines[#lines + 1] = panel(0.93, 0.52) .. "set format x \"\"\nunset xlabel\n" ..
                       "set ylabel \"normal stress (MPa, scaled to rock)\"\n"
   lines[#lines + 1] = ("plot %s using 1:2 with lines lw 1 lc rgb %s title \"at the record\", \\\n" ..
                        "  %s using 1:3 with lines lw 2 lc rgb %s title \"mean over the record interval\", \\\n" ..
-                       "  %.10g with lines dt 2 lw 2 lc rgb %s title %s\n"):format(
-    quote(d), quote(GREY), quote(d), quote(BLUE), o.target, quote(RED),
-    quote(("target %g MPa"):format(o.target)))
+                       "  %s using 1:5 with lines dt 2 lw 2 lc rgb %s title %s\n"):format(
+    quote(d), quote(GREY), quote(d), quote(BLUE), quote(d), quote(RED),
+    quote(o.target_values and o.target_label or ("target %g MPa"):format(o.target)))
   lines[#lines + 1] = panel(0.49, 0.08) .. "set format x \"%g\"\nset xlabel \"shear displacement (mm)\"\n" ..
                       "set ylabel \"shear / normal stress, tau / sigma_n\"\n"
   local items = {("%s using 1:4 with lines lw 2 lc rgb %s title \"tau / sigma_n\""):format(quote(d), quote(BLUE))}
