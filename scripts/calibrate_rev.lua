@@ -15,33 +15,40 @@
 -- Writes out/summary.json (trials, per-seed results, means and standard deviations) and prints the
 -- line to put into scripts/lib/materials.lua.
 local mat = require("materials")
-local P = require("params").defaults{
-  target_mpa = mat.rock.tensile_strength / 1e6,
-  start = 0,                              -- Pa, first trial st (0: the calibrated one of materials.lua)
-  tolerance = 0.01,                       -- relative, on the mean scaled tensile strength
-  iterations = 6,
-  seeds = "1,2,3,4,5",                    -- packings averaged
-  compression = true,                     -- also test the calibrated st in compression
-  isotropy = true,                        -- also E and nu along x and y
-  bond_shear_ratio = mat.rev.bond_shear_ratio,
-  bond_radius_factor = mat.rev.bond_radius_factor,
-  rotation_lock_bonds = mat.rev.rotation_lock_bonds,
-  bond_gap = 0,
-  genesis_stress = mat.genesis.stress,
-  porosity = mat.genesis.porosity,
-  out = "out/calibration",
-  cache = "",                             -- packings cached here (default out/cache)
+local params_lib = require("params")
+local P = params_lib.parse{
+  script = "calibrate_rev.lua",
+  path = "scripts/calibrate_rev.lua",
+  about = "the bond tensile strength st for which the REV's scaled tensile strength, over several packings, is the target",
+  {"target_mpa", mat.rock.tensile_strength / 1e6, unit = "MPa", above = 0, doc = "target tensile strength, scaled to rock (Table 3-1: 6.6)"},
+  {"start", 0, unit = "Pa", min = 0, doc = "first trial st, model units (0: the calibrated one of materials.lua)"},
+  {"tolerance", 0.01, above = 0, below = 1, doc = "relative, on the mean scaled tensile strength"},
+  {"iterations", 6, type = "integer", min = 1, doc = "most trials"},
+  {"seeds", "1,2,3,4,5", list = "number", min = 1, doc = "packings averaged (positive integers)"},
+  {"compression", true, doc = "also test the calibrated st in compression"},
+  {"isotropy", true, doc = "also E and nu along x and y"},
+  {"bond_shear_ratio", mat.rev.bond_shear_ratio, min = 0, doc = "passed to rev.lua"},
+  {"bond_radius_factor", mat.rev.bond_radius_factor, above = 0, max = 1, doc = "passed to rev.lua"},
+  {"rotation_lock_bonds", mat.rev.rotation_lock_bonds, type = "integer", min = 1, doc = "passed to rev.lua"},
+  {"bond_gap", 0, unit = "m", min = 0, doc = "passed to rev.lua"},
+  {"genesis_stress", mat.genesis.stress, unit = "Pa", min = 0, doc = "passed to rev.lua"},
+  {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "passed to rev.lua"},
+  {"out", "out/calibration", nonempty = true, doc = "output folder (one folder per trial and seed)"},
+  {"cache", "", doc = "packings cached here (\"\": out/cache)"},
+  check = function(P, fail)
+    local list = params_lib.split(P.seeds, true)
+    if #list == 0 then fail("seeds", "must give at least one seed (e.g. seeds=1,2,3)") end
+    for _, v in ipairs(list) do
+      if math.tointeger(v) == nil then fail("seeds", ("'%s' is not an integer"):format(v)) end
+    end
+  end,
 }
+if not P then return end   -- help printed
 if P.start <= 0 then P.start = mat.rev.bond_tensile_strength end
 local out = asperity.mkdir(P.out)
 local cache = P.cache ~= "" and P.cache or out .. "/cache"
 local seeds = {}
-for s in P.seeds:gmatch("[^,%s]+") do
-  local v = math.tointeger(tonumber(s))
-  if not v or v < 1 then error(("seeds: '%s' is not a positive integer (give e.g. seeds=1,2,3)"):format(s)) end
-  seeds[#seeds + 1] = v
-end
-if #seeds == 0 then error("seeds: give at least one seed (e.g. seeds=1,2,3)") end
+for _, v in ipairs(params_lib.split(P.seeds, true)) do seeds[#seeds + 1] = math.tointeger(v) end
 local rev_script = asperity.scripts_dir .. "/rev.lua"
 
 local function rev(st, tests, seed, name)

@@ -10,16 +10,21 @@
 --   energy.h5, energy.csv                      energies and the equilibrium ratio over time
 --   energy.png                                 kinetic energy and unbalanced-force ratio plots
 --   summary.json                               parameters and final state
-local P = require("params").defaults{
-  n = 400,            -- particles
-  radius = 0.01,      -- mean radius, m
-  ratio = 1e-3,       -- unbalanced-force ratio that counts as settled
-  max_steps = 100000,
-  snapshots = 10,     -- snapshots during the fall
-  out = "out/demo",
-  seed = 1,
-  threads = 0,        -- 0: automatic (a few hundred particles run on one thread)
+local P = require("params").parse{
+  script = "demo.lua",
+  path = "scripts/demo.lua",
+  about = "a few hundred spheres dropped into a box settle under gravity",
+  -- the box is 24 radii square and 240 tall; its lattice (pack.grid, pitch 3.6 radii) holds 6 x 6 x 66
+  {"n", 400, type = "integer", min = 1, max = 2376, doc = "particles"},
+  {"radius", 0.01, unit = "m", above = 0, doc = "mean radius"},
+  {"ratio", 1e-3, above = 0, below = 1, doc = "unbalanced-force ratio that counts as settled"},
+  {"max_steps", 100000, type = "integer", min = 1, doc = "most steps"},
+  {"snapshots", 10, type = "integer", min = 0, doc = "snapshots during the fall"},
+  {"out", "out/demo", nonempty = true, doc = "output folder"},
+  {"seed", 1, type = "integer", min = 0, doc = "of the lattice jitter"},
+  {"threads", 0, type = "integer", min = 0, doc = "0: automatic (a few hundred particles run on one thread)"},
 }
+if not P then return end   -- help printed
 local walls = require("walls")
 local pack = require("pack")
 local record = require("record")
@@ -58,8 +63,10 @@ snaps:write(world)
 energy:write(P.out .. "/energy")
 local plotted = pcall(function()
   energy:plot{file = P.out .. "/energy.png", x = "time", y = {"kinetic"}, logy = true,
-              title = ("%d spheres settling"):format(P.n)}
-  energy:plot{file = P.out .. "/ratio.png", x = "time", y = {"unbalanced_ratio"}, logy = true}
+              title = ("%d spheres settling"):format(P.n), xlabel = "time (s)", ylabel = "kinetic energy (J)"}
+  energy:plot{file = P.out .. "/ratio.png", x = "time", y = {"unbalanced_ratio"}, logy = true,
+              title = ("%d spheres settling"):format(P.n), xlabel = "time (s)",
+              ylabel = "mean unbalanced force / mean contact force"}
 end)
 
 local _, _, ztop = world:positions():max()

@@ -19,94 +19,122 @@
 -- The halves are made by the REV's genesis (lib/genesis.lua), so they are the calibrated
 -- material. Stresses are reported in model units and scaled to rock [3-37].
 --
--- Writes into `out`: summary.json; closure.{h5,csv}, shear.{h5,csv}; snapshots (HDF5 + XDMF) at
--- the displacements in `snapshots`; PNG plots: shear stress and dilatancy, closure curve, contact
--- count, broken bonds, energies, and maps of contact points and broken bonds over the elevation.
+-- Writes into `out` (created once every check has passed): summary.json; closure.{h5,csv},
+-- shear.{h5,csv} (stresses in model Pa and in MPa scaled to rock, closure and displacements in
+-- mm; the stress scale and the parameters as attributes); snapshots joint.xdmf (XDMF time = shear
+-- displacement, mm) at the displacements in `snapshots` and joint_closure.xdmf (closure, mm);
+-- PNG plots: shear stress and dilatancy, normal stress and tau / sigma_n, closure curve, contact
+-- count, broken bonds, energies, and maps of contact points and broken bonds over the elevation
+-- at the peak and at the end. `--help` lists the parameters.
 local mat = require("materials")
 local radii_lib = require("radii")
 local genesis = require("genesis")
 local heightmap = require("heightmap")
 
-local P = require("params").defaults{
-  surface = "S1",          -- S1..S8 (surfaces.md table 4), or "flat" (a plane: the control case)
-  surface_file = "",       -- or an HDF5 height map (dataset `height`, attribute `spacing`)
-  scale = "",              -- "thesis": size 0.1 m (about 110 000 particles)
-  size = 0.02,             -- side of the square joint, m
-  thickness = 0.006,       -- each half beyond the mean plane, m
-  spacing = 0.1 / 365,     -- surface grid spacing, m (the thesis grid)
-  model = "elastic",       -- rigid | elastic | fracture
-  stress = 14,             -- normal stress, MPa (scaled)
-  direction = "x",         -- x | y: the upper half moves along -x or -y
-  shear = 5,               -- shear displacement, mm
-  velocity = 1.5e-5,       -- shear velocity, m/s (perf/runtime_vs_error.lua: within 1 % of a 2x slower run)
-  ramp = 0.05,             -- mm over which the shear velocity rises linearly from 0 (no start-up impact)
-  quasi_static_limit = 0.01, -- warn when the kinetic energy exceeds this x normal load x mean radius
-  overlap_limit = 0.5,     -- warn when a contact overlaps this fraction of the smaller radius (the engine
-                           -- stops at 1): the contacts are too soft for the load (perf/README.md)
-  normal_control = "servo", -- servo (model.md 7, with integral action), load: a constant force on a free platen,
-                           -- or stiffness: constant normal stiffness, sigma_0 + normal_stiffness x dilatancy
-  normal_stiffness = 0,    -- MPa/mm (scaled) of normal_control=stiffness
-  platen_damping = 0,      -- local damping of the dead-load platen (< 0: the world's)
-  servo_relaxation = 0.4,  -- servo gain: fraction of the force error the platen contacts correct per step
-  servo_integral_steps = 2, -- integral time of the servo, in time steps (0: proportional only, model.md 7)
-  servo_max_velocity = 100, -- the servo's speed limit, in shear velocities
-  closure_velocity = 6e-5, -- m/s [thesis 4.2.2]
-  closure_every = 0,       -- steps between closure records (the source: 500; 0: 50, or 1 for the rigid
-                           -- model, whose large time step closes the joint in a few dozen steps)
-  approach_gap = 0.2e-3,    -- m, smallest gap left between the halves after lowering the upper one
-  gap = 1e-3,              -- m, between the halves while they relax
-  platen = 1.5e-3,         -- m, layer of each outer face that forms a platen
-  porosity = mat.genesis.porosity,  -- thesis definition [3-35]: the particle count of the genesis
-  genesis_stress = mat.genesis.stress, -- Pa, isotropic stress installed before bonding (scenarios.md 1)
-  bond_gap = 0,            -- m, largest gap bonded (0: the engine's default, 1e-3 x mean radius)
-  wall_friction = 0,       -- of the box walls and the mould during the genesis (scenarios.md 1: frictionless)
-  seed = 1,
-  pack_steps = 300000,     -- most steps spent cycling the packing towards the ratio 1e-4
-  record = 0.01,           -- mm of shear between records
-  dt_safety = 0,           -- time step / critical estimate for closure and shear; 0: 1.0 for the elastic
-                           -- and fracture models (changes no result by more than 0.2 %,
-                           -- perf/runtime_vs_error.lua), the engine's 0.8 for the rigid one (its
-                           -- bodies' estimate is coarser: 1.0 ran away while closing a tiny joint)
-  skin = 0,                -- Verlet skin, m (0: 0.1 mean radius, the rigid model 0.4; perf/README.md)
-  snapshots = "0,1,2.5,5", -- mm of shear
-  band = 0,                -- surface vs porosity band, m (0: mean radius)
-  out = "out/joint",
-  cache = "out/cache",
-  threads = 0,
-  simd = "auto",           -- kernels of closure and shear: auto, an architecture, or "float" (the force laws
-                           -- in single precision, scalar: perf/runtime_vs_error.lua's study); packing: auto
-  progress = true,
-  events_every = 0,        -- steps between energy samples for the event statistics (events.{h5,csv}); 0: none
-  save = "",               -- a path: the world's checkpoint when the shear ends (to continue from it,
-                           -- or to time the shear step in one process: perf/README.md, perf/ab.sh)
-  stop_after = "",         -- "packing": stop once the halves are packed, before bonding (the world
-                           -- saved to `save` if given: to look at the packing, or to time its step)
+local params_lib = require("params")
+local R = mat.packing.mean_radius
+local P = params_lib.parse{
+  script = "joint.lua",
+  path = "scripts/joint.lua",
+  about = "a rock joint closed and sheared under constant normal load",
+  {"surface", "S1", oneof = {"S1", "S2", "S3", "S4", "S5", "S6", "S7", "S8", "flat"},
+   doc = "reference surface (surfaces.md table 4), or flat: a plane, the control case"},
+  {"surface_file", "", file = true, doc = "an HDF5 height map instead (dataset `height`, attribute `spacing`)"},
+  {"scale", "", oneof = {"", "thesis"}, doc = "thesis: size 0.1 m (about 110 000 particles) unless size is given"},
+  {"size", 0.02, unit = "m", min = 4 * R, doc = "side of the square joint"},
+  {"thickness", 0.006, unit = "m", min = 2 * R, doc = "each half beyond the mean plane"},
+  {"spacing", 0.1 / 365, unit = "m", above = 0, doc = "surface grid spacing (the thesis grid)"},
+  {"model", "elastic", oneof = {"rigid", "elastic", "fracture"},
+   doc = "rigid bodies, unbreakable bonds, or the calibrated breakable bonds [scenarios.md 4]"},
+  {"stress", 14, unit = "MPa", above = 0, doc = "normal stress, scaled to rock (model Pa x stress scale)"},
+  {"direction", "x", oneof = {"x", "y"}, doc = "the upper half moves along -x or -y"},
+  {"shear", 5, unit = "mm", above = 0, doc = "shear displacement"},
+  {"residual_window", 0.5, unit = "mm", above = 0, doc = "the residual stress is the mean over the last this much of the shear"},
+  {"velocity", 1.5e-5, unit = "m/s", above = 0, doc = "shear velocity (perf/runtime_vs_error.lua: within 1 % of a 2x slower run)"},
+  {"ramp", 0.05, unit = "mm", min = 0, doc = "the shear velocity rises linearly from 0 over this displacement"},
+  {"quasi_static_limit", 0.01, above = 0, doc = "warn when the kinetic energy exceeds this x normal load x mean radius"},
+  {"overlap_limit", 0.5, above = 0, max = 1,
+   doc = "warn when a contact overlaps this fraction of the smaller radius (the engine stops at 1)"},
+  {"normal_control", "servo", oneof = {"servo", "load", "stiffness"},
+   doc = "servo (model.md 7, with integral action), load: a constant force on a free platen, or stiffness: "
+         .. "constant normal stiffness, sigma_0 + normal_stiffness x dilatancy"},
+  {"normal_stiffness", 0, unit = "MPa/mm", min = 0, doc = "scaled to rock; of normal_control=stiffness (> 0 there, 0 otherwise)"},
+  {"platen_damping", 0, below = 1, doc = "local damping of the dead-load platen (< 0: the world's)"},
+  {"servo_relaxation", 0.4, above = 0, max = 1, doc = "servo gain: fraction of the force error corrected per step"},
+  {"servo_integral_steps", 2, min = 0, doc = "integral time of the servo, in time steps (0: proportional only)"},
+  {"servo_max_velocity", 100, above = 0, doc = "the servo's speed limit, in shear velocities"},
+  {"closure_velocity", 6e-5, unit = "m/s", above = 0, doc = "closure velocity [thesis 4.2.2]"},
+  {"closure_every", 0, type = "integer", min = 0,
+   doc = "steps between closure records (0: 50, or 1 for the rigid model, which closes in a few dozen steps)"},
+  {"approach_gap", 0.2e-3, unit = "m", min = 0, doc = "smallest gap left between the halves after lowering the upper one"},
+  {"gap", 1e-3, unit = "m", min = 0, doc = "between the halves while they relax"},
+  {"platen", 1.5e-3, unit = "m", above = 0, doc = "layer of each outer face that forms a platen"},
+  {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "thesis definition [3-35]: the particle count of the genesis"},
+  {"genesis_stress", mat.genesis.stress, unit = "Pa", min = 0, doc = "isotropic stress installed before bonding (scenarios.md 1; model units)"},
+  {"bond_gap", 0, unit = "m", min = 0, doc = "largest gap bonded (0: the engine's default, 1e-3 x mean radius)"},
+  {"wall_friction", 0, min = 0, doc = "of the box walls and the mould during the genesis (scenarios.md 1: frictionless)"},
+  {"seed", 1, type = "integer", min = 0, doc = "of the surface and the packing"},
+  {"pack_steps", 300000, type = "integer", min = 1, doc = "most steps spent cycling the packing towards the ratio 1e-4"},
+  {"record", 0.01, unit = "mm", above = 0, doc = "shear displacement between records"},
+  {"dt_safety", 0, min = 0, max = 2,
+   doc = "time step / critical estimate for closure and shear (0: 1.0 elastic and fracture, 0.8 rigid; above 1 only to study instability)"},
+  {"skin", 0, unit = "m", min = 0, doc = "Verlet skin (0: 0.1 mean radius, the rigid model 0.4)"},
+  {"snapshots", "0,1,2.5,5", list = "number", unit = "mm", min = 0,
+   doc = "shear displacements of the particle snapshots, within 0 .. shear (\"\": none; by default those "
+         .. "within a shorter shear and its end)"},
+  {"band", 0, unit = "m", min = 0, doc = "surface vs porosity band (0: mean radius)"},
+  {"out", "out/joint", nonempty = true, doc = "output folder (created when the run starts writing)"},
+  {"cache", "", doc = "folder of cached specimens (\"\": $ASPERITY_CACHE, else ~/.cache/asperity, else out/cache)"},
+  {"threads", 0, type = "integer", min = 0, doc = "0: automatic"},
+  {"simd", "auto", oneof = {"auto", "float", "scalar", "sse4_2", "avx2", "avx512f"},
+   doc = "kernels of closure and shear; float: the force laws in single precision"},
+  {"progress", true, doc = "progress line on the terminal"},
+  {"events_every", 0, type = "integer", min = 0,
+   doc = "steps between energy samples for the event statistics (events.{h5,csv}); 0: none"},
+  {"save", "", doc = "a path: the world's checkpoint when the shear ends"},
+  {"stop_after", "", oneof = {"", "packing"}, doc = "packing: stop once the halves are packed, before bonding"},
+  check = function(P, fail, given)
+    if P.residual_window >= P.shear then
+      fail("shear", ("must exceed the residual window (residual_window = %g mm): the residual is the "
+                     .. "mean over the last residual_window of the shear"):format(P.residual_window))
+    end
+    if P.record >= P.shear then fail("record", ("must be < shear (%g mm)"):format(P.shear)) end
+    if P.ramp >= P.shear then fail("ramp", ("must be < shear (%g mm)"):format(P.shear)) end
+    if given.snapshots ~= nil then
+      for _, s in ipairs(params_lib.split(P.snapshots, true)) do
+        if s > P.shear then fail("snapshots", ("%g mm is beyond shear = %g mm"):format(s, P.shear)) end
+      end
+    else
+      -- the default list follows a shorter shear: the displacements within it, and its end
+      local kept = {}
+      for _, s in ipairs(params_lib.split(P.snapshots, true)) do
+        if s < P.shear then kept[#kept + 1] = ("%g"):format(s) end
+      end
+      kept[#kept + 1] = ("%g"):format(P.shear)
+      P.snapshots = table.concat(kept, ",")
+    end
+    -- Constant normal stiffness: a stiffness is what makes it one (0 would be the servo's CNL).
+    if P.normal_control == "stiffness" and not (P.normal_stiffness > 0) then
+      fail("normal_stiffness", "must be > 0 with normal_control=stiffness")
+    elseif P.normal_control ~= "stiffness" and P.normal_stiffness ~= 0 then
+      fail("normal_stiffness", ("needs normal_control=stiffness (now %s)"):format(P.normal_control))
+    end
+    if P.platen >= P.thickness then fail("platen", ("must be < thickness (%g m)"):format(P.thickness)) end
+    local size = (P.scale == "thesis" and params.size == nil) and 0.1 or P.size
+    local cells = size / P.spacing
+    if cells < 2 or cells > 32766 then
+      fail("spacing", ("gives %.0f grid cells over size = %g m; must give 2 .. 32766"):format(cells, size))
+    end
+  end,
 }
-if P.scale == "thesis" then
-  if params.size == nil then P.size = 0.1 end
-elseif P.scale ~= "" then
-  error("scale must be \"thesis\" or empty, got '" .. P.scale .. "'")
-end
-local models = {rigid = true, elastic = true, fracture = true}
-if not models[P.model] then error("model must be rigid, elastic or fracture, got '" .. P.model .. "'") end
-if P.direction ~= "x" and P.direction ~= "y" then error("direction must be x or y") end
-if P.stop_after ~= "" and P.stop_after ~= "packing" then
-  error("stop_after must be \"packing\" or empty, got '" .. P.stop_after .. "'")
-end
-for _, key in ipairs{"quasi_static_limit", "overlap_limit"} do
-  if not (P[key] > 0) then error(("%s must be > 0, got %s"):format(key, tostring(P[key]))) end
-end
--- Constant normal stiffness: a stiffness is what makes it one (0 would be the servo's CNL).
-if P.normal_control == "stiffness" and not (P.normal_stiffness > 0 and P.normal_stiffness < math.huge) then
-  error(("normal_stiffness must be > 0 MPa/mm with normal_control=stiffness, got %s"):format(tostring(P.normal_stiffness)), 0)
-elseif P.normal_control ~= "stiffness" and P.normal_stiffness ~= 0 then
-  error(("normal_stiffness=%s needs normal_control=stiffness (now '%s')"):format(tostring(P.normal_stiffness), P.normal_control), 0)
-end
-if math.type(P.events_every) ~= "integer" or P.events_every < 0 then
-  error(("events_every must be a whole number of steps >= 0 (0: no samples), got %s"):format(tostring(P.events_every)), 0)
+if not P then return end   -- help printed
+if P.scale == "thesis" and params.size == nil then P.size = 0.1 end
+if P.cache == "" then
+  local home = os.getenv("HOME")
+  P.cache = os.getenv("ASPERITY_CACHE") or (os.getenv("XDG_CACHE_HOME") and os.getenv("XDG_CACHE_HOME") .. "/asperity")
+            or (home and home ~= "" and home .. "/.cache/asperity") or (P.out .. "/cache")
 end
 local t_start = asperity.wall_time()
-asperity.mkdir(P.out)
 asperity.mkdir(P.cache)
 local function log(fmt, ...) io.stderr:write(("[joint] " .. fmt .. "\n"):format(...)) end
 
@@ -373,6 +401,21 @@ local rev = mat.rev
 local stress_scale = mat.rock.young_modulus / rev.young_modulus        -- [3-37]
 local target_stress = P.stress * 1e6 / stress_scale                   -- model units, Pa
 local function mpa(sigma) return sigma * stress_scale / 1e6 end
+-- Units of the stress columns in the HDF5 and CSV files: the model's own Pa, or MPa scaled to the
+-- rock by stress_scale [3-37] (an attribute of every file, with the run's parameters).
+local MODEL_PA, ROCK_MPA = "Pa (model)", "MPa (scaled to rock)"
+local function label_series(series)
+  series:set_attribute("stress_scale", stress_scale)
+  series:set_attribute("stress_units", "columns in '" .. MODEL_PA .. "' are model stresses; columns in '" ..
+                       ROCK_MPA .. "' are model stresses x stress_scale / 1e6")
+  local names = {}
+  for name in pairs(P) do names[#names + 1] = name end
+  table.sort(names)
+  for _, name in ipairs(names) do
+    local v = P[name]
+    series:set_attribute("parameter_" .. name, type(v) == "boolean" and tostring(v) or v)
+  end
+end
 -- Outer faces of the specimen: the lowest point of the lower half, the highest of the upper.
 local zlo, zhi = math.huge, -math.huge
 for _, id in ipairs(lower) do zlo = math.min(zlo, pos[id][3]) end
@@ -439,6 +482,16 @@ else
 end
 
 local bonds_at_start = world:bond_count()
+-- Particle snapshots (HDF5 + XDMF) indexed by `label` (the shear or the closure displacement in
+-- mm), with the keys of the integer fields; the particles left out of the specimen are not
+-- written, so they are not drawn as debris between the halves.
+local function joint_snapshots(name, label)
+  local groups = P.model == "rigid" and ("%d: lower half (rigid), %d: upper half (rigid), -1: none")
+                 or ("%d: lower platen, %d: upper platen, -1: none (bonded particles)")
+  return asperity.snapshots{dir = P.out, name = name, time = label, exclude_tag = LOST,
+                            keys = {group = groups:format(bottom, top),
+                                    tag = ("%d: lower half, %d: upper half"):format(LOWER, UPPER)}}
+end
 
 -- 5. Assembly: bring the halves together until exactly one contact exists [4.2.1] ------------
 local function between() return world:contact_summary(LOWER, UPPER, POROSITY) end
@@ -450,8 +503,14 @@ log("halves in contact after %d steps", steps)
 
 -- 6. Closure at constant velocity to the normal stress [thesis 4.2.2] -----------------------
 local z_contact = world:group_position(top)[3]
-local closure = asperity.series{"closure [m]", "closure_corrected [m]", "normal_stress [Pa]",
-  "normal_stress_mpa [MPa]", "contacts [1]", "contact_area [%]", "broken_bonds [1]", "time [s]"}
+-- The output folder appears only now, once every refusal (parameters, the fracture model's
+-- strength check) has had its say: a run that fails to start leaves no empty folder behind.
+asperity.mkdir(P.out)
+local function closure_mm() return 1e3 * (z_contact - world:group_position(top)[3]) end
+local closure_snaps = joint_snapshots("joint_closure", "closure (mm)")
+closure_snaps:write(world, {stage = "closure", closure_mm = 0, stress_scale = stress_scale}, 0)
+local closure = asperity.series{"closure [mm]", "closure_corrected [mm]", "normal_stress [" .. MODEL_PA .. "]",
+  "normal_stress_mpa [" .. ROCK_MPA .. "]", "contacts [1]", "contact_area [%]", "broken_bonds [1]", "time [s]"}
 local height = zhi - zlo
 -- Force of the particles on the upper platen (the group force less any applied dead load).
 local applied_z = 0
@@ -475,7 +534,7 @@ local function record_closure()
   local s = normal_stress()
   local c = between()
   local d = z_contact - world:group_position(top)[3]
-  closure:record(d, d - s * height / rev.young_modulus, s, mpa(s), c.count,
+  closure:record(1e3 * d, 1e3 * (d - s * height / rev.young_modulus), s, mpa(s), c.count,
                  100 * c.area / area, world:break_count(), world:time())
 end
 world:set_group_motion(top, {velocity = {0, 0, -P.closure_velocity}})
@@ -491,6 +550,8 @@ world:run{steps = 10000000, every = 1, progress = P.progress,
           end}
 record_closure()
 log("closed to %.3g MPa in %.1f um", mpa(normal_stress()), 1e6 * (z_contact - world:group_position(top)[3]))
+closure_snaps:write(world, {stage = "closure", closure_mm = closure_mm(), stress_scale = stress_scale}, closure_mm())
+label_series(closure)
 closure:write(P.out .. "/closure")
 
 -- Normal stiffness: slope of stress against closure over the upper half of the loading.
@@ -503,7 +564,7 @@ end
 local cd, cs = closure:column("closure"), closure:column("normal_stress_mpa")
 local kx, ky = {}, {}
 for k = 1, closure:rows() do
-  if cs[k] >= 0.5 * P.stress then kx[#kx + 1] = cd[k] * 1e3; ky[#ky + 1] = cs[k] end
+  if cs[k] >= 0.5 * P.stress then kx[#kx + 1] = cd[k]; ky[#ky + 1] = cs[k] end
 end
 local normal_stiffness = fit(kx, ky)   -- MPa/mm
 
@@ -548,20 +609,30 @@ do
             end}
   log("settled on the normal load in %d steps", n)
 end
-local shear = asperity.series{"displacement [mm]", "shear_stress [Pa]", "shear_stress_mpa [MPa]",
-  "normal_stress_mpa [MPa]", "normal_stress_mean_mpa [MPa]", "dilatancy [mm]", "contacts [1]", "contact_area [%]",
-  "broken_bonds [1]", "porosity_shear_stress_mpa [MPa]", "kinetic [J]", "strain [J]",
+local shear = asperity.series{"displacement [mm]", "shear_stress [" .. MODEL_PA .. "]", "shear_stress_mpa [" .. ROCK_MPA .. "]",
+  "normal_stress_mpa [" .. ROCK_MPA .. "]", "normal_stress_mean_mpa [" .. ROCK_MPA .. "]", "dilatancy [mm]", "contacts [1]", "contact_area [%]",
+  "broken_bonds [1]", "porosity_shear_stress_mpa [" .. ROCK_MPA .. "]", "kinetic [J]", "strain [J]",
   "friction [J]", "damping [J]", "released [J]", "boundary_work [J]", "shear_work [J]",
   "dilatancy_work [J]", "time [s]"}
 local c0 = world:group_position(top)
 local e0 = world:energies()
 local shear_work, dilatancy_work = 0, 0
 local last_pos, last_force = c0, platen_force()
-local snaps = asperity.snapshots{dir = P.out, name = "joint"}
+local snaps = joint_snapshots("joint", "shear displacement (mm)")
 local snap_at = {}
-for v in P.snapshots:gmatch("[^,]+") do snap_at[#snap_at + 1] = tonumber(v) end
+for _, v in ipairs(params_lib.split(P.snapshots, true)) do snap_at[#snap_at + 1] = v end
+table.sort(snap_at)
 local next_snap = 1
-local contact_points = {}
+-- The contact points between the halves at the highest shear stress so far: at the end, those of
+-- the peak (for its contact map).
+local peak_seen, peak_points = -math.huge, nil
+local function points_between()
+  local pts = {}
+  for _, ct in ipairs(world:contacts()) do
+    if world:tag(ct.a) ~= world:tag(ct.b) then pts[#pts + 1] = {ct.point[1], ct.point[2]} end
+  end
+  return pts
+end
 local function displacement() return (c0[axis] - world:group_position(top)[axis]) * 1e3 end
 -- The normal stress averaged over each recording interval, as a load cell with a low-pass filter
 -- reads it (the instantaneous value also carries the platen's inertia at each slip event of the
@@ -594,13 +665,11 @@ local function record_shear()
                e.kinetic, e.strain - e0.strain, e.friction - e0.friction, e.damping - e0.damping,
                e.released - e0.released, e.boundary_work - e0.boundary_work, shear_work,
                dilatancy_work, world:time())
+  if mpa(tau) > peak_seen then
+    peak_seen, peak_points = mpa(tau), {at = displacement(), step = world:step(), points = points_between()}
+  end
   while next_snap <= #snap_at and displacement() >= snap_at[next_snap] - 1e-9 do
-    snaps:write(world)
-    local pts = {}
-    for _, ct in ipairs(world:contacts()) do
-      if world:tag(ct.a) ~= world:tag(ct.b) then pts[#pts + 1] = {ct.point[1], ct.point[2]} end
-    end
-    contact_points[#contact_points + 1] = {at = snap_at[next_snap], points = pts}
+    snaps:write(world, {stage = "shear", shear_displacement_mm = displacement(), stress_scale = stress_scale}, displacement())
     next_snap = next_snap + 1
   end
 end
@@ -661,6 +730,7 @@ if P.save ~= "" then
 end
 local shear_seconds, shear_steps = asperity.wall_time() - shear_t0, world:step() - shear_s0
 local shear_rebuilds = world:stats().rebuilds - shear_r0
+label_series(shear)
 shear:write(P.out .. "/shear")
 if events then events:write(P.out .. "/events") end
 -- Every bond break while shearing (model.md 5), for the event statistics and maps.
@@ -684,14 +754,14 @@ local cnt = shear:column("contacts")
 local rows = shear:rows()
 local peak, at = -math.huge, 1
 for k = 1, rows do if tau[k] > peak then peak, at = tau[k], k end end
--- Residual: the mean shear stress over the last 0.5 mm, from the platen's impulse (the exact time
+-- Residual: the mean shear stress over the last residual_window mm, from the platen's impulse (the exact time
 -- mean, so it does not depend on the record interval; at constant velocity time and displacement
 -- means agree).
 local residual
 do
   local time = shear:column("time")
   local first = rows
-  while first > 1 and u[first - 1] >= u[rows] - 0.5 do first = first - 1 end
+  while first > 1 and u[first - 1] >= u[rows] - P.residual_window do first = first - 1 end
   if first < rows and time[rows] > time[first] then
     residual = mpa((shear_impulse[rows] - shear_impulse[first]) / (time[rows] - time[first]) / area)
   else
@@ -778,9 +848,20 @@ local summary = {
   bonds = world:bond_count(),
   stress_scale = stress_scale,
   target_stress_pa = target_stress,
+  stress_units = "*_mpa: MPa scaled to rock (model Pa x stress_scale / 1e6); *_pa: model Pa",
+  -- The shear stress of the first record, before the platen moves: the lateral force the held
+  -- platen carries once the closure is done (the normal load on inclined asperity contacts pushes
+  -- the halves sideways). The shear curve starts from it.
+  shear_stress_at_start_mpa = tau[1],
+  closure_mm = closure:column("closure")[closure:rows()],
   peak_shear_stress_mpa = peak,
   peak_displacement_mm = u[at],
   residual_shear_stress_mpa = residual,
+  -- the reference study's values for this surface, model and stress, where it has them
+  reference = P.surface_file == "" and require("reference").joint(P.surface, P.model, P.stress) or nil,
+  residual_window_mm = P.residual_window,    -- the residual: the mean over the last this much shear
+  peak_friction = peak / P.stress,           -- tau / sigma_n at the peak
+  residual_friction = residual / P.stress,
   kinetic_ratio_max = dynamic_ratio,         -- max Ek / (normal load x mean radius) while shearing
   kinetic_ratio_max_at_mm = dynamic_at,
   quasi_static = dynamic_ratio <= P.quasi_static_limit,
@@ -822,49 +903,61 @@ local summary = {
 asperity.write_json(P.out .. "/summary.json", summary)
 
 -- 9. Plots ----------------------------------------------------------------------------------
-pcall(function()
-  local title = ("%s, %s model, %g MPa, shear along -%s"):format(P.surface, P.model, P.stress, P.direction)
-  shear:plot{file = P.out .. "/shear_stress.png", x = "displacement", y = {"shear_stress_mpa"}, title = title}
-  shear:plot{file = P.out .. "/dilatancy.png", x = "displacement", y = {"dilatancy"}, title = title}
-  shear:plot{file = P.out .. "/contacts.png", x = "displacement", y = {"contacts"}, title = title}
-  shear:plot{file = P.out .. "/broken_bonds.png", x = "displacement", y = {"broken_bonds"}, title = title}
-  shear:plot{file = P.out .. "/energies.png", x = "displacement",
-             y = {"boundary_work", "friction", "damping", "strain", "released"}, title = title}
-  closure:plot{file = P.out .. "/closure.png", x = "closure", y = {"normal_stress_mpa"}, title = title}
+local plotted, plot_error = pcall(function()
+  local jf = require("joint_figures")
+  local ref = require("reference")
+  local surface_name = P.surface_file ~= "" and P.surface_file:match("[^/]*$") or P.surface
+  local title = ("%s, %s model, %g MPa normal stress, shear along -%s (%d particles)"):format(
+    surface_name, P.model, P.stress, P.direction, #lower + #upper)
+  local res_from = u[rows] - P.residual_window
+  jf.shear{file = P.out .. "/shear_stress.png", title = title, u = u, tau = tau, dilatancy = dil,
+           peak = {at = u[at], value = peak}, residual = {value = residual, from = res_from, to = u[rows]},
+           reference = P.surface_file == "" and ref.joint(P.surface, P.model, P.stress) or nil}
+  local cns = P.normal_control == "stiffness"
+  local asked
+  if cns then
+    asked = {}
+    for k = 1, rows do asked[k] = P.stress + P.normal_stiffness * dil[k] end
+  end
+  jf.cnl{file = P.out .. "/normal_stress.png", title = title .. (cns and ": constant normal stiffness" or ": constant normal load"),
+         u = u, tau = tau, sn = sn, sn_mean = sn_mean, target = P.stress, target_values = asked,
+         target_label = cns and ("target %g MPa + %g MPa/mm x dilatancy"):format(P.stress, P.normal_stiffness) or nil,
+         reference = not cns and ref.ratios(P.model, P.stress) or nil}
+  jf.closure{file = P.out .. "/closure.png", title = title .. ": closure", closure = closure:column("closure"),
+             sn = closure:column("normal_stress_mpa"), target = P.stress, stiffness = normal_stiffness}
+  local peak_mark = {at = u[at], label = "peak"}
+  jf.curves{file = P.out .. "/contacts.png", title = title, x = u, mark = peak_mark,
+            ylabel = "contacts between the halves", curves = {{cnt}}, from_zero = true}
+  jf.curves{file = P.out .. "/broken_bonds.png", title = title, x = u, mark = peak_mark,
+            ylabel = "broken bonds", curves = {{shear:column("broken_bonds")}}, from_zero = true}
+  local function col(name) return shear:column(name) end
+  jf.curves{file = P.out .. "/energies.png", title = title .. ": energy since the shear began", x = u,
+            ylabel = "energy (J, model units)",
+            curves = {{col("boundary_work"), "work done by the platens"}, {col("friction"), "dissipated by friction"},
+                      {col("damping"), "dissipated by damping"}, {col("strain"), "stored in contacts and bonds"},
+                      {col("released"), "released by broken bonds"}, {col("kinetic"), "kinetic"}}}
 end)
--- Contact points at the last snapshot and broken bonds over the elevation map.
+if not plotted then log("plots skipped: %s", tostring(plot_error)) end
+-- Contact points and broken bonds over the elevation map, at the peak and at the end.
 pcall(function()
-  local pts = contact_points[#contact_points]
-  local data = os.tmpname()
-  local fh = assert(io.open(data, "w"))
-  for j = 1, ny do
-    for i = 1, nx do fh:write(("%.6g %.6g %.6g\n"):format((i - 1) * h * 1e3, (j - 1) * h * 1e3, heights[(j - 1) * nx + i] * 1e3)) end
-    fh:write("\n")
+  local jf = require("joint_figures")
+  local events = world:break_events()
+  local function broken_until(step)
+    local pts = {}
+    for _, ev in ipairs(events) do
+      if not step or ev.step <= step then pts[#pts + 1] = {ev.position[1], ev.position[2]} end
+    end
+    return pts
   end
-  fh:write("\n\n")
-  if pts then for _, p in ipairs(pts.points) do fh:write(("%.6g %.6g 0\n"):format(p[1] * 1e3, p[2] * 1e3)) end end
-  fh:write("NaN NaN NaN\n\n\n")
-  for _, ev in ipairs(world:break_events()) do
-    fh:write(("%.6g %.6g 0\n"):format(ev.position[1] * 1e3, ev.position[2] * 1e3))
+  local label = ("%s, %s model, %g MPa"):format(P.surface, P.model, P.stress)
+  if peak_points then
+    jf.contact_map{file = P.out .. "/contact_map_peak.png", nx = nx, ny = ny, h = h, heights = heights,
+                   points = peak_points.points, broken = broken_until(peak_points.step),
+                   title = ("%s: at the peak, %.2f mm of shear"):format(label, peak_points.at)}
   end
-  fh:write("NaN NaN NaN\n")
-  fh:close()
-  local script = os.tmpname()
-  local gp = assert(io.open(script, "w"))
-  gp:write(([[set terminal pngcairo noenhanced size 900,800
-set output "%s"
-set title "%s: contacts between the halves at %s mm (black), broken bonds (white)"
-set xlabel "x [mm]"
-set ylabel "y [mm]"
-set cblabel "elevation [mm]"
-set size ratio -1
-set view map
-plot "%s" index 0 using 1:2:3 with image notitle, "%s" index 1 using 1:2 with points pt 7 ps 0.6 lc rgb "black" title "contacts", "%s" index 2 using 1:2 with points pt 6 ps 0.6 lc rgb "white" title "broken bonds"
-]]):format(P.out .. "/contact_map.png", P.surface, pts and tostring(pts.at) or "?", data, data, data))
-  gp:close()
-  os.execute("gnuplot " .. script .. " 2>/dev/null")
-  os.remove(script)
-  os.remove(data)
+  jf.contact_map{file = P.out .. "/contact_map.png", nx = nx, ny = ny, h = h, heights = heights,
+                 points = points_between(), broken = broken_until(nil),
+                 title = ("%s: at the end, %.2f mm of shear"):format(label, displacement())}
 end)
 
 print(("%s %s %g MPa -%s: %d particles, peak %.2f MPa at %.2f mm, residual %.2f MPa, " ..

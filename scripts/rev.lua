@@ -42,43 +42,61 @@ local figures = require("figures")
 -- The calibrated material of the chosen bond installation (scripts/lib/materials.lua) supplies
 -- the defaults of st and the packing stress.
 local rev = mat.rev
-local P = require("params").defaults{
-  size = 0.01, porosity = mat.genesis.porosity, seed = 1,
-  mean_radius = mat.packing.mean_radius, radius_sd = mat.packing.radius_sd,
-  kn = mat.contact.kn, ks = mat.contact.ks, friction = mat.contact.friction,
-  damping = mat.damping, density = mat.density,
-  genesis_stress = mat.genesis.stress,           -- Pa, isotropic stress the genesis installs before bonding
-  floater_contacts = mat.genesis.floater_contacts, -- particles with fewer contacts are taken out
-  tensile_strength = rev.bond_tensile_strength,  -- Pa, bond st (elliptic criterion)
-  bond_shear_ratio = rev.bond_shear_ratio,       -- kbs / kbn of the parallel bonds
-  bond_radius_factor = rev.bond_radius_factor,   -- lambda: Rb = lambda min(Ra, Rb) [3-26]
-  rate = 1e-6,               -- m/s, platen velocity (thesis: 1 um/s)
-  elastic_strain = 2e-4,     -- strain reached in the elastic tests
-  stop_fraction = 0.7,       -- fracture tests stop when |stress| < this x peak (after the peak)
-  max_strain = 0.02,         -- ... or at this strain
-  platen = 1e-3,             -- m, platen thickness (particles within it of the face)
-  ratio = 1e-4,              -- equilibrium: mean unbalanced / mean contact force
-  every = 100,               -- steps between recorded rows
-  tests = "elastic,isotropy,shear,compression,tension",   -- which tests to run
-  rate_check = false,
-  lock_rotation = true,      -- model.md 2: bonded particles do not rotate
-  rotation_lock_bonds = rev.rotation_lock_bonds, -- ... while they hold at least this many intact bonds
-  bond_gap = 0,              -- m, largest gap bonded (0: the engine's default, 1e-3 x mean radius)
-  dt_safety = 0,             -- time step / critical estimate in the tests (0: the engine's 0.8)
-  cache = "",                -- a folder: the packing is cached there and reused (calibrate_rev.lua)
-  threads = 1,
-  simd = "auto",             -- kernels of bonding and tests: auto, an architecture, or "float" (the force laws
-                             -- in single precision, scalar: perf/runtime_vs_error.lua's study); packing: auto
-  out = "out/rev",
+local params_lib = require("params")
+local TESTS = {"elastic", "isotropy", "shear", "compression", "tension"}
+local P = params_lib.parse{
+  script = "rev.lua",
+  path = "scripts/rev.lua",
+  about = "the REV: a bonded cube packed, bonded, freed and tested in compression, tension and shear",
+  {"size", 0.01, unit = "m", above = 0, doc = "side of the cube"},
+  {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "nominal porosity [3-35]"},
+  {"seed", 1, type = "integer", min = 0, doc = "of the radii and the packing"},
+  {"mean_radius", mat.packing.mean_radius, unit = "m", above = 0, doc = "mean particle radius"},
+  {"radius_sd", mat.packing.radius_sd, unit = "m", min = 0, doc = "standard deviation of the radii (cut at 3 SD)"},
+  {"kn", mat.contact.kn, unit = "N/m", above = 0, doc = "contact normal stiffness"},
+  {"ks", mat.contact.ks, unit = "N/m", min = 0, doc = "contact shear stiffness"},
+  {"friction", mat.contact.friction, min = 0, doc = "contact friction coefficient"},
+  {"damping", mat.damping, min = 0, below = 1, doc = "local damping"},
+  {"density", mat.density, unit = "kg/m^3", above = 0, doc = "particle density"},
+  {"genesis_stress", mat.genesis.stress, unit = "Pa", min = 0, doc = "isotropic stress the genesis installs before bonding (model units)"},
+  {"floater_contacts", mat.genesis.floater_contacts, type = "integer", min = 0,
+   doc = "particles with fewer contacts are taken out"},
+  {"tensile_strength", rev.bond_tensile_strength, unit = "Pa", above = 0,
+   doc = "bond strength st of the elliptic criterion (model units; the calibrated one by default)"},
+  {"bond_shear_ratio", rev.bond_shear_ratio, min = 0, doc = "kbs / kbn of the parallel bonds"},
+  {"bond_radius_factor", rev.bond_radius_factor, above = 0, max = 1, doc = "lambda: Rb = lambda min(Ra, Rb) [3-26]"},
+  {"rate", 1e-6, unit = "m/s", above = 0, doc = "platen velocity (thesis: 1 um/s)"},
+  {"elastic_strain", 2e-4, above = 0, below = 0.1, doc = "strain reached in the elastic tests"},
+  {"stop_fraction", 0.7, above = 0, below = 1, doc = "fracture tests stop when |stress| < this x peak, after the peak"},
+  {"max_strain", 0.02, above = 0, below = 1, doc = "... or at this strain"},
+  {"platen", 1e-3, unit = "m", above = 0, doc = "platen thickness (particles within it of the face)"},
+  {"ratio", 1e-4, above = 0, below = 1, doc = "equilibrium: mean unbalanced / mean contact force"},
+  {"every", 100, type = "integer", min = 1, doc = "steps between recorded rows"},
+  {"tests", "elastic,isotropy,shear,compression,tension", list = "string", oneof = TESTS, doc = "which tests to run"},
+  {"rate_check", false, doc = "also run the elastic tests at half the rate"},
+  {"lock_rotation", true, doc = "model.md 2: bonded particles do not rotate"},
+  {"rotation_lock_bonds", rev.rotation_lock_bonds, type = "integer", min = 1,
+   doc = "... while they hold at least this many intact bonds"},
+  {"bond_gap", 0, unit = "m", min = 0, doc = "largest gap bonded (0: the engine's default, 1e-3 x mean radius)"},
+  {"dt_safety", 0, min = 0, max = 2, doc = "time step / critical estimate in the tests (0: the engine's 0.8; above 1 only to study instability)"},
+  {"cache", "", doc = "a folder: the packing is cached there and reused (calibrate_rev.lua)"},
+  {"threads", 1, type = "integer", min = 0, doc = "0: automatic"},
+  {"simd", "auto", oneof = {"auto", "float", "scalar", "sse4_2", "avx2", "avx512f"},
+   doc = "kernels of bonding and tests; float: the force laws in single precision"},
+  {"out", "out/rev", nonempty = true, doc = "output folder"},
+  check = function(P, fail)
+    if P.platen >= P.size / 2 then fail("platen", ("must be < size / 2 (%g m)"):format(P.size / 2)) end
+    if P.size < 4 * P.mean_radius then fail("size", ("must be >= 4 mean radii (%g m)"):format(4 * P.mean_radius)) end
+    if P.radius_sd * 3 >= P.mean_radius then
+      fail("radius_sd", ("must be < mean_radius / 3 (%g m): radii are cut at 3 SD and must stay positive"):format(P.mean_radius / 3))
+    end
+    if #params_lib.split(P.tests) == 0 then fail("tests", "must name at least one test") end
+  end,
 }
+if not P then return end   -- help printed
 local out = asperity.mkdir(P.out)
 local want = {}
-for name in P.tests:gmatch("[^,%s]+") do
-  if not ({elastic = true, shear = true, compression = true, tension = true, isotropy = true})[name] then
-    error("tests: unknown test '" .. name .. "' (elastic, isotropy, shear, compression, tension)")
-  end
-  want[name] = true
-end
+for _, name in ipairs(params_lib.split(P.tests)) do want[name] = true end
 want.elastic = want.elastic or want.shear or want.isotropy  -- shear and isotropy compare with E and nu
 local L = P.size
 local area = L * L
@@ -231,10 +249,10 @@ end
 
 -- One test from a checkpoint: the top platen moves at `velocity`; rows every P.every steps;
 -- `stop(row, peak)` ends it. slab = true also records the mean stress tensor of the middle slab.
-local columns = {"step", "time [s]", "displacement [m]", "axial_stress [Pa]", "shear_stress [Pa]",
+local columns = {"step", "time [s]", "displacement [m]", "axial_stress [Pa (model)]", "shear_stress [Pa (model)]",
                  "axial_strain", "lateral_strain", "strain_x", "strain_y", "shear_strain",
-                 "shear_strain_layers", "broken_bonds", "slab_xx [Pa]", "slab_yy [Pa]", "slab_zz [Pa]",
-                 "slab_xz [Pa]", "slab_zx [Pa]"}
+                 "shear_strain_layers", "broken_bonds", "slab_xx [Pa (model)]", "slab_yy [Pa (model)]", "slab_zz [Pa (model)]",
+                 "slab_xz [Pa (model)]", "slab_zx [Pa (model)]"}
 local function run_test(checkpoint, name, velocity, o)
   local t0 = asperity.wall_time()
   local platens, gauges = rigs[checkpoint].platens, rigs[checkpoint].gauges
@@ -385,7 +403,7 @@ local fracture
 local function break_map(w, name, title)
   local events = w:break_events()
   local f = assert(io.open(out .. "/" .. name .. "_breaks.csv", "w"))
-  f:write("step,time [s],x [m],y [m],z [m],a,b,mode,sigma [Pa],tau [Pa],released_energy [J]\n")
+  f:write("step,time [s],x [m],y [m],z [m],a,b,mode,sigma [Pa (model)],tau [Pa (model)],released_energy [J]\n")
   local modes = {tension = 1, shear = 2, compression = 3}
   local pts = {}
   for _, e in ipairs(events) do

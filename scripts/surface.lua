@@ -21,13 +21,32 @@
 --   psd.png           radially averaged PSD with the fitted slope -(2 + 2H)
 --   abbott.png        Abbott-Firestone (bearing area) curve
 --   with noise=true: noise.csv and noise.png (H and s2 against added white noise)
-local P = require("params").defaults{
-  name = "", H = 0, Lc = 0, variance = 0,
-  Hx = 0, Hy = 0, Lcx = 0, Lcy = 0, variance_x = 0, variance_y = 0,
-  n = 365, L = 0.10, seed = 1,
-  noise = false,
-  out = "out/surface",
+local names = {""}
+for k = 1, 8 do names[#names + 1] = "S" .. k end
+local P = require("params").parse{
+  script = "surface.lua",
+  path = "scripts/surface.lua",
+  about = "a self-affine rough surface: generated, measured, written and plotted",
+  {"name", "", oneof = names, doc = "a reference surface (spec table 4); H, Lc, variance given with it override it"},
+  {"H", 0, min = 0, below = 1, doc = "Hurst exponent (0: not given)"},
+  {"Lc", 0, unit = "m", min = 0, doc = "roll-off (correlation) length (0: not given)"},
+  {"variance", 0, unit = "m^2", min = 0, doc = "height variance s2 (0: not given)"},
+  {"Hx", 0, min = 0, below = 1, doc = "anisotropic: Hurst exponent along x (0: not given)"},
+  {"Hy", 0, min = 0, below = 1, doc = "anisotropic: along y"},
+  {"Lcx", 0, unit = "m", min = 0, doc = "anisotropic: roll-off length along x"},
+  {"Lcy", 0, unit = "m", min = 0, doc = "anisotropic: along y"},
+  {"variance_x", 0, unit = "m^2", min = 0, doc = "anisotropic: variance along x"},
+  {"variance_y", 0, unit = "m^2", min = 0, doc = "anisotropic: along y"},
+  {"n", 365, type = "integer", min = 3, max = 32767, doc = "grid points per side, odd"},
+  {"L", 0.10, unit = "m", above = 0, doc = "side of the surface"},
+  {"seed", 1, type = "integer", min = 0, doc = "of the random phases"},
+  {"noise", false, doc = "also the noise study (H and s2 against added white noise)"},
+  {"out", "out/surface", nonempty = true, doc = "output folder"},
+  check = function(P, fail)
+    if P.n % 2 == 0 then fail("n", "must be odd (the spectral method keeps only (0, 0) self-conjugate)") end
+  end,
 }
+if not P then return end   -- help printed
 local S = asperity.surface
 local plots = require("surface_plots")
 

@@ -1,6 +1,7 @@
 // The command-line program.
 //
 //   asperity run SCRIPT.lua [key=value ...]   run a script; key=value pairs reach it as `params`
+//   asperity run SCRIPT.lua --help            the script's parameters (it receives help=true)
 //   asperity repl [SCRIPT.lua] [key=value ...] interactive Lua with the API (after the script)
 //   asperity --version                        version, build type, SIMD architecture
 //
@@ -21,6 +22,7 @@ namespace {
 const char* const kUsage =
     "usage:\n"
     "  asperity run SCRIPT.lua [key=value ...]    run a script (params.key = value)\n"
+    "  asperity run SCRIPT.lua --help             the script's parameters (as help=true)\n"
     "  asperity repl [SCRIPT.lua] [key=value ...] interactive session, after SCRIPT if given\n"
     "  asperity --version                         version, build type and SIMD in use\n"
     "  asperity --help                            this text\n";
@@ -37,11 +39,16 @@ bool is_identifier(const std::string& s) {
   return true;
 }
 
-// key=value pairs after the script name.
+// key=value pairs after the script name. --help (or -h) there is help=true: the scripts that
+// declare their parameters (scripts/lib/params.lua) then list them instead of running.
 bool parse_params(int argc, char** argv, int first, std::vector<std::pair<std::string, std::string>>& out,
                   std::string& error) {
   for (int i = first; i < argc; ++i) {
     std::string a = argv[i];
+    if (a == "--help" || a == "-h") {
+      out.emplace_back("help", "true");
+      continue;
+    }
     auto eq = a.find('=');
     if (eq == std::string::npos || !is_identifier(a.substr(0, eq))) {
       error = "parameter '" + a + "' is not of the form key=value (key a Lua name)";

@@ -135,10 +135,13 @@ void plot_png(const fs::path& path, const Column& x, std::span<const Column> ys,
   gp << "set terminal pngcairo noenhanced size " << options.width << "," << options.height
      << "\nset output " << quoted(png.temp_path().string())
      << "\nset xlabel " << quoted(options.xlabel.empty() ? x.label() : options.xlabel)
-     << "\nset ylabel " << quoted(ylabel) << "\nset grid\nset key top right\n";
+     << "\nset ylabel " << quoted(ylabel) << "\nset grid\n";
+  // One curve needs no key (the axis label names it); several get theirs beside the plot, where
+  // it never hides data.
+  gp << (ys.size() == 1 ? "unset key\n" : "set key outside right top\n");
   if (!options.title.empty()) gp << "set title " << quoted(options.title) << "\n";
   if (options.logx) gp << "set logscale x\n";
-  if (options.logy) gp << "set logscale y\n";
+  if (options.logy) gp << "set logscale y\nset format y \"%g\"\n";
   gp << "plot ";
   for (std::size_t j = 0; j < ys.size(); ++j) {
     if (j) gp << ", \\\n     ";

@@ -28,13 +28,21 @@ Snapshot take_snapshot(const World& world, bool with_contacts, std::int64_t id_b
   s.position = world.positions();
   s.velocity = world.velocities();
   s.radius = world.radii();
+  s.force = world.forces();
   s.id.resize(n);
   s.group.resize(n);
+  s.tag.resize(n);
+  s.angular_velocity.resize(3 * n);
   for (std::size_t i = 0; i < n; ++i) {
     auto id = static_cast<std::int64_t>(i);
     s.id[i] = id + id_base;
     int g = world.group_of(id);
     s.group[i] = g < 0 ? -1 : static_cast<std::int32_t>(g + id_base);
+    s.tag[i] = static_cast<std::int32_t>(world.tag(id));
+    Vec3 w = world.angular_velocity(id);
+    s.angular_velocity[3 * i] = w.x;
+    s.angular_velocity[3 * i + 1] = w.y;
+    s.angular_velocity[3 * i + 2] = w.z;
   }
   if (with_contacts) {
     s.has_contacts = true;
@@ -82,6 +90,78 @@ Snapshot take_snapshot(const World& world, bool with_contacts, std::int64_t id_b
   return s;
 }
 
+void drop_particles(Snapshot& s, const std::vector<bool>& keep) {
+  const std::size_t n = s.id.size();
+  if (keep.size() != n) throw Error("drop_particles: the mask has the wrong length");
+  std::vector<std::int32_t> row(n, -1);
+  std::size_t m = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (keep[i]) row[i] = static_cast<std::int32_t>(m++);
+  // Compacts a per-particle array of `width` values per row.
+  auto compact = [&](auto& v, std::size_t width) {
+    if (v.empty()) return;
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      if (keep[i])
+        for (std::size_t d = 0; d < width; ++d) v[k++] = v[width * i + d];
+    v.resize(k);
+  };
+  compact(s.id, 1);
+  compact(s.position, 3);
+  compact(s.velocity, 3);
+  compact(s.radius, 1);
+  compact(s.group, 1);
+  compact(s.tag, 1);
+  compact(s.force, 3);
+  compact(s.angular_velocity, 3);
+  compact(s.displacement, 3);
+  // Pairs: kept when both ends are, their rows renumbered.
+  auto pairs = [&](std::vector<std::int32_t>& a, std::vector<std::int32_t>& b, auto&& move_rest) {
+    std::size_t k = 0;
+    for (std::size_t e = 0; e < a.size(); ++e) {
+      std::int32_t ra = row[static_cast<std::size_t>(a[e])], rb = row[static_cast<std::size_t>(b[e])];
+      if (ra < 0 || rb < 0) continue;
+      a[k] = ra;
+      b[k] = rb;
+      move_rest(k, e);
+      ++k;
+    }
+    return k;
+  };
+  if (s.has_contacts) {
+    std::size_t k = pairs(s.index_a, s.index_b, [&](std::size_t to, std::size_t from) {
+      s.id_a[to] = s.id_a[from];
+      s.id_b[to] = s.id_b[from];
+      s.overlap[to] = s.overlap[from];
+      s.normal_force[to] = s.normal_force[from];
+      for (int d = 0; d < 3; ++d) {
+        s.normal[3 * to + d] = s.normal[3 * from + d];
+        s.point[3 * to + d] = s.point[3 * from + d];
+        s.shear_force[3 * to + d] = s.shear_force[3 * from + d];
+      }
+    });
+    for (auto* v : {&s.index_a, &s.index_b}) v->resize(k);
+    for (auto* v : {&s.id_a, &s.id_b}) v->resize(k);
+    for (auto* v : {&s.overlap, &s.normal_force}) v->resize(k);
+    for (auto* v : {&s.normal, &s.point, &s.shear_force}) v->resize(3 * k);
+  }
+  if (s.has_bonds) {
+    std::size_t k = pairs(s.bond_index_a, s.bond_index_b, [&](std::size_t to, std::size_t from) {
+      s.bond_id_a[to] = s.bond_id_a[from];
+      s.bond_id_b[to] = s.bond_id_b[from];
+      s.bond_normal_force[to] = s.bond_normal_force[from];
+      s.bond_sigma[to] = s.bond_sigma[from];
+      s.bond_tau[to] = s.bond_tau[from];
+      s.bond_gap[to] = s.bond_gap[from];
+      for (int d = 0; d < 3; ++d) s.bond_shear_force[3 * to + d] = s.bond_shear_force[3 * from + d];
+    });
+    for (auto* v : {&s.bond_index_a, &s.bond_index_b}) v->resize(k);
+    for (auto* v : {&s.bond_id_a, &s.bond_id_b}) v->resize(k);
+    for (auto* v : {&s.bond_normal_force, &s.bond_sigma, &s.bond_tau, &s.bond_gap}) v->resize(k);
+    s.bond_shear_force.resize(3 * k);
+  }
+}
+
 namespace {
 std::vector<std::int32_t> interleave(const std::vector<std::int32_t>& a, const std::vector<std::int32_t>& b) {
   std::vector<std::int32_t> out(2 * a.size());
@@ -104,6 +184,7 @@ void write_snapshot_hdf5(const std::filesystem::path& path, const Snapshot& s) {
     h5::Handle f = h5::create_file(file.temp_path());
     h5::write_attribute(f, "step", static_cast<std::int64_t>(s.step), name);
     h5::write_attribute(f, "time", s.time, name);
+    if (s.index_time) h5::write_attribute(f, "index_time", *s.index_time, name);
     h5::write_attribute(f, "id_base", s.id_base, name);
     h5::write_attributes(f, s.attributes, name);
     {
@@ -113,6 +194,12 @@ void write_snapshot_hdf5(const std::filesystem::path& path, const Snapshot& s) {
       h5::write_doubles(g, "velocity", s.velocity, 3, "m/s", name);
       h5::write_doubles(g, "radius", s.radius, 0, "m", name);
       h5::write_int32(g, "group", s.group, 0, "", name);
+      if (!s.tag.empty()) h5::write_int32(g, "tag", s.tag, 0, "", name);
+      if (!s.force.empty()) h5::write_doubles(g, "force", s.force, 3, "N", name);
+      if (!s.angular_velocity.empty())
+        h5::write_doubles(g, "angular_velocity", s.angular_velocity, 3, "rad/s", name);
+      if (!s.displacement.empty()) h5::write_doubles(g, "displacement", s.displacement, 3, "m", name);
+      h5::write_attributes(g, s.particle_attributes, name);
       std::vector<std::int32_t> index(n);
       for (std::size_t i = 0; i < n; ++i) index[i] = static_cast<std::int32_t>(i);
       h5::write_int32(g, "index", index, 0, "", name);
@@ -144,11 +231,30 @@ void write_snapshot_hdf5(const std::filesystem::path& path, const Snapshot& s) {
   file.commit();
 }
 
-SnapshotSeries::SnapshotSeries(std::filesystem::path directory, std::string name)
-    : directory_(std::move(directory)), name_(std::move(name)) {
+namespace {
+// NAME_NNNNNN.h5 (six digits or more) or NAME.xdmf / NAME_contacts.xdmf / NAME_bonds.xdmf.
+bool is_series_file(const std::string& file, const std::string& name) {
+  if (file == name + ".xdmf" || file == name + "_contacts.xdmf" || file == name + "_bonds.xdmf") return true;
+  if (file.size() < name.size() + 1 + 6 + 3 || file.compare(0, name.size() + 1, name + "_") != 0 ||
+      file.compare(file.size() - 3, 3, ".h5") != 0)
+    return false;
+  for (std::size_t i = name.size() + 1; i < file.size() - 3; ++i)
+    if (file[i] < '0' || file[i] > '9') return false;
+  return true;
+}
+}  // namespace
+
+SnapshotSeries::SnapshotSeries(std::filesystem::path directory, std::string name,
+                               SnapshotSeriesOptions options)
+    : directory_(std::move(directory)), name_(std::move(name)), options_(std::move(options)) {
   if (name_.empty() || name_.find('/') != std::string::npos)
     throw Error("snapshot series name '" + name_ + "' must be a plain file name");
   make_directories(directory_);
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(directory_, ec)) {
+    if (!entry.is_regular_file()) continue;
+    if (is_series_file(entry.path().filename().string(), name_)) std::filesystem::remove(entry.path(), ec);
+  }
 }
 
 std::filesystem::path SnapshotSeries::xdmf_path() const { return directory_ / (name_ + ".xdmf"); }
@@ -159,12 +265,22 @@ std::filesystem::path SnapshotSeries::bonds_xdmf_path() const {
   return directory_ / (name_ + "_bonds.xdmf");
 }
 
-std::filesystem::path SnapshotSeries::write(const Snapshot& snapshot) {
+std::filesystem::path SnapshotSeries::write(Snapshot snapshot) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "_%06zu.h5", entries_.size());
   std::string file = name_ + buf;
+  const std::size_t n = snapshot.id.size();
+  snapshot.displacement.assign(3 * n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* x = &snapshot.position[3 * i];
+    auto [it, first_seen] = reference_.try_emplace(snapshot.id[i], std::array<double, 3>{x[0], x[1], x[2]});
+    if (!first_seen)
+      for (int d = 0; d < 3; ++d) snapshot.displacement[3 * i + d] = x[d] - it->second[d];
+  }
+  for (const auto& key : options_.keys) snapshot.particle_attributes.push_back(key);
+  if (!options_.time_label.empty()) snapshot.attributes.emplace_back("index_time_label", options_.time_label);
   write_snapshot_hdf5(directory_ / file, snapshot);
-  entries_.push_back(Entry{file, snapshot.step, snapshot.time, snapshot.id.size(),
+  entries_.push_back(Entry{file, snapshot.step, snapshot.index_time.value_or(snapshot.time), snapshot.id.size(),
                            snapshot.id_a.size(), snapshot.bond_id_a.size(), snapshot.has_contacts,
                            snapshot.has_bonds});
   write_xdmf();
@@ -182,6 +298,20 @@ std::string data_item(const std::string& file, const std::string& dataset, std::
   return o.str();
 }
 
+std::string xml_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
 std::string time_text(double t) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.17g", t);
@@ -193,6 +323,12 @@ void SnapshotSeries::write_xdmf() const {
   std::ostringstream p, c, b;
   const char* head = "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n";
   p << head << "  <Grid Name=\"" << name_ << "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  // What the time axis and the integer keys mean, for whoever opens the file.
+  p << "   <Information Name=\"time\" Value=\""
+    << xml_escape(options_.time_label.empty() ? "simulated time (s)" : options_.time_label) << "\"/>\n";
+  for (const auto& [key, value] : options_.keys)
+    if (const auto* text = std::get_if<std::string>(&value))
+      p << "   <Information Name=\"" << xml_escape(key) << "\" Value=\"" << xml_escape(*text) << "\"/>\n";
   c << head << "  <Grid Name=\"" << name_ << "_contacts\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
   b << head << "  <Grid Name=\"" << name_ << "_bonds\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
   bool any_contacts = false, any_bonds = false;
@@ -217,6 +353,12 @@ void SnapshotSeries::write_xdmf() const {
     attribute(p, "velocity", "Vector", "Node",
               data_item(f, "/particles/velocity", n, 3, "Float", 8));
     attribute(p, "group", "Scalar", "Node", data_item(f, "/particles/group", n, 0, "Int", 4));
+    attribute(p, "tag", "Scalar", "Node", data_item(f, "/particles/tag", n, 0, "Int", 4));
+    attribute(p, "displacement", "Vector", "Node",
+              data_item(f, "/particles/displacement", n, 3, "Float", 8));
+    attribute(p, "force", "Vector", "Node", data_item(f, "/particles/force", n, 3, "Float", 8));
+    attribute(p, "angular_velocity", "Vector", "Node",
+              data_item(f, "/particles/angular_velocity", n, 3, "Float", 8));
     p << "   </Grid>\n";
     if (e.has_contacts) {
       any_contacts = true;

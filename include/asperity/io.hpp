@@ -14,12 +14,14 @@
 // No HDF5 type appears here: the HDF5 C API is an implementation detail of engine/io/.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <span>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -150,6 +152,10 @@ struct Snapshot {
   std::vector<std::int64_t> id;
   std::vector<double> position, velocity, radius;
   std::vector<std::int32_t> group;  // -1: none (group ids shifted by id_base like particle ids)
+  std::vector<std::int32_t> tag;    // the world's per-particle tag (not shifted)
+  std::vector<double> force, angular_velocity;  // N, rad/s, as x0,y0,z0,x1,...
+  // Since the first snapshot of the series, per particle (filled by SnapshotSeries::write).
+  std::vector<double> displacement;
   // Touching ball-ball pairs. index_a/b are rows of the particle arrays (what XDMF lines need);
   // id_a/b are particle ids.
   bool has_contacts = false;
@@ -162,13 +168,22 @@ struct Snapshot {
   std::vector<std::int32_t> bond_index_a, bond_index_b;
   std::vector<double> bond_normal_force, bond_shear_force, bond_sigma, bond_tau, bond_gap;
   Attributes attributes;
+  Attributes particle_attributes;  // on /particles (the keys of group and tag)
+  // The XDMF time of this snapshot when the series is indexed by something other than the
+  // simulated time (e.g. the shear displacement in mm); unset: `time`.
+  std::optional<double> index_time;
 };
 
 // Reads the world through its public API (bonds whenever the world has any). id_base: see
 // Snapshot.
 Snapshot take_snapshot(const World& world, bool with_contacts, std::int64_t id_base = 0);
 
-// Layout: /particles/{id,position,velocity,radius,group,index}, /contacts/{id_a,id_b,pair,
+// Keeps only the particles with keep[row] true (rows in the snapshot's order); contacts and bonds
+// with a dropped particle go too, and the remaining ones' rows are renumbered.
+void drop_particles(Snapshot& snapshot, const std::vector<bool>& keep);
+
+// Layout: /particles/{id,position,velocity,radius,group,tag,force,angular_velocity,
+// displacement,index}, /contacts/{id_a,id_b,pair,
 // normal,point,overlap,normal_force,shear_force}, /bonds/{id_a,id_b,pair,normal_force,
 // shear_force,sigma,tau,gap}; root attributes step, time, id_base and the snapshot's own.
 // Dimensional datasets have a `units` attribute.
@@ -178,10 +193,18 @@ void write_snapshot_hdf5(const std::filesystem::path& path, const Snapshot& snap
 // when contacts are written, NAME_contacts.xdmf (contacts as lines between particle centres),
 // and with bonds NAME_bonds.xdmf.
 // The XDMF files are rewritten (atomically) after every snapshot so they are always complete.
+// A new series removes the files of an earlier series of the same name in the directory
+// (NAME_NNNNNN.h5 and NAME*.xdmf), so a rerun never mixes its snapshots with stale ones.
+// Each snapshot gets the displacement of every particle since the series' first snapshot (by id;
+// zero for a particle first seen later).
+struct SnapshotSeriesOptions {
+  std::string time_label;   // what the XDMF time is, e.g. "shear displacement (mm)"; "" = time (s)
+  Attributes keys;          // legends written on /particles, e.g. {"group_key", "1: lower platen"}
+};
 class SnapshotSeries {
  public:
-  SnapshotSeries(std::filesystem::path directory, std::string name);
-  std::filesystem::path write(const Snapshot& snapshot);
+  SnapshotSeries(std::filesystem::path directory, std::string name, SnapshotSeriesOptions options = {});
+  std::filesystem::path write(Snapshot snapshot);
   std::size_t count() const { return entries_.size(); }
   std::filesystem::path xdmf_path() const;
   std::filesystem::path contacts_xdmf_path() const;
@@ -191,14 +214,16 @@ class SnapshotSeries {
   struct Entry {
     std::string file;
     std::uint64_t step;
-    double time;
+    double time;  // the index time (see Snapshot::index_time)
     std::size_t particles, contacts, bonds;
     bool has_contacts, has_bonds;
   };
   void write_xdmf() const;
   std::filesystem::path directory_;
   std::string name_;
+  SnapshotSeriesOptions options_;
   std::vector<Entry> entries_;
+  std::unordered_map<std::int64_t, std::array<double, 3>> reference_;  // first position, by id
 };
 
 // ---------------------------------------------------------------------------------------------

@@ -170,6 +170,94 @@ TEST(Snapshot, ParticlesAndContactsReadBack) {
   fs::remove_all(dir);
 }
 
+// A series indexed by another quantity (the shear displacement): XDMF times and labels from the
+// script, displacements since the first snapshot, particles of one tag left out with the contacts'
+// rows renumbered, and a new series removing an earlier one's files.
+TEST(Snapshot, IndexTimeDisplacementExclusionAndStaleFiles) {
+  fs::path dir = fresh_dir("snapshot_index");
+  {
+    std::ofstream(dir / "p_000007.h5") << "stale";
+    std::ofstream(dir / "p.xdmf") << "stale";
+    std::ofstream(dir / "p_contacts.xdmf") << "stale";
+    std::ofstream(dir / "p_notes.txt") << "kept";
+    std::ofstream(dir / "p_closure_000000.h5") << "another series";
+  }
+  WorldSettings settings;
+  settings.contact.kn = 1e3;
+  World world(settings);
+  // three touching spheres in a row; the middle one tagged 3 (left out of the files)
+  for (int i = 0; i < 3; ++i) world.add_particle({0.0199 * i, 0, 0}, 0.01);
+  std::int64_t middle[1] = {1};
+  world.set_tag(middle, 3);
+  std::int64_t last[1] = {2};
+  world.set_tag(last, 2);
+  world.cycle(1);
+  ASSERT_EQ(world.contacts().size(), 2u) << "the test needs both contacts";
+
+  io::SnapshotSeriesOptions options;
+  options.time_label = "shear displacement (mm)";
+  options.keys = {{"tag_key", std::string("2: upper half")}};
+  io::SnapshotSeries series(dir, "p", options);
+  EXPECT_FALSE(fs::exists(dir / "p_000007.h5"));
+  EXPECT_FALSE(fs::exists(dir / "p_contacts.xdmf"));
+  EXPECT_TRUE(fs::exists(dir / "p_notes.txt"));
+  EXPECT_TRUE(fs::exists(dir / "p_closure_000000.h5"));
+
+  auto take = [&](double index_time, bool drop_middle) {
+    io::Snapshot s = io::take_snapshot(world, true, 1);
+    s.index_time = index_time;
+    if (drop_middle) io::drop_particles(s, {true, false, true});
+    return series.write(std::move(s));
+  };
+  std::vector<double> x0 = io::read_hdf5(take(0.0, false), "/particles/position");
+  world.set_position(2, {0.05, 0.01, -0.02});
+  fs::path file = take(2.5, true);
+
+  std::vector<double> id = io::read_hdf5(file, "/particles/id");
+  EXPECT_EQ(id, (std::vector<double>{1, 3}));
+  std::vector<double> u = io::read_hdf5(file, "/particles/displacement");
+  ASSERT_EQ(u.size(), 6u);
+  EXPECT_DOUBLE_EQ(u[3], 0.05 - x0[6]);
+  EXPECT_DOUBLE_EQ(u[4], 0.01 - x0[7]);
+  EXPECT_DOUBLE_EQ(u[5], -0.02 - x0[8]);
+  EXPECT_EQ(u[0], 0.0);
+  EXPECT_EQ(io::read_hdf5(file, "/particles/tag"), (std::vector<double>{0, 2}));
+  EXPECT_EQ(io::hdf5_shape(file, "/particles/force"), (std::vector<std::size_t>{2, 3}));
+  EXPECT_EQ(io::hdf5_shape(file, "/particles/angular_velocity"), (std::vector<std::size_t>{2, 3}));
+  // both contacts touched the left-out middle sphere: none is left
+  EXPECT_EQ(io::read_hdf5(file, "/contacts/normal_force").size(), 0u);
+  EXPECT_EQ(std::get<std::string>(*io::read_hdf5_attribute(file, "/particles", "tag_key")), "2: upper half");
+  EXPECT_DOUBLE_EQ(std::get<double>(*io::read_hdf5_attribute(file, "/", "index_time")), 2.5);
+
+  std::string xdmf = read_text(series.xdmf_path());
+  EXPECT_NE(xdmf.find("<Time Value=\"2.5\"/>"), std::string::npos);
+  EXPECT_NE(xdmf.find("<Information Name=\"time\" Value=\"shear displacement (mm)\"/>"), std::string::npos);
+  EXPECT_NE(xdmf.find("<Information Name=\"tag_key\" Value=\"2: upper half\"/>"), std::string::npos);
+  EXPECT_NE(xdmf.find("TopologyType=\"Polyvertex\" NumberOfElements=\"2\""), std::string::npos);
+  EXPECT_NE(xdmf.find("Attribute Name=\"displacement\""), std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST(Snapshot, DropParticlesRenumbersTheContactRows) {
+  WorldSettings settings;
+  settings.contact.kn = 1e3;
+  World world(settings);
+  for (int i = 0; i < 4; ++i) world.add_particle({0.0199 * i, 0, 0}, 0.01);
+  world.cycle(1);
+  io::Snapshot s = io::take_snapshot(world, true, 1);
+  ASSERT_EQ(s.index_a.size(), 3u);
+  io::drop_particles(s, {false, true, true, true});   // the first sphere goes, and its contact
+  ASSERT_EQ(s.index_a.size(), 2u);
+  EXPECT_EQ(s.id, (std::vector<std::int64_t>{2, 3, 4}));
+  for (std::size_t k = 0; k < 2; ++k) {
+    // rows point at the same particles as the ids
+    EXPECT_EQ(s.id[static_cast<std::size_t>(s.index_a[k])], s.id_a[k]);
+    EXPECT_EQ(s.id[static_cast<std::size_t>(s.index_b[k])], s.id_b[k]);
+  }
+  EXPECT_EQ(s.position.size(), 9u);
+  EXPECT_EQ(s.force.size(), 9u);
+}
+
 TEST(Hdf5, ReadingErrorsNameTheProblem) {
   fs::path dir = fresh_dir("h5errors");
   try {

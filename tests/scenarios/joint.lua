@@ -6,7 +6,7 @@ local out = assert(params.out, "give out=DIRECTORY")
 local cache = out .. "/cache"
 local function joint(p)
   local given = {size = 0.008, thickness = 0.003, shear = 1, pack_steps = 50000, progress = false,
-                 cache = cache}
+                 cache = cache, snapshots = "0,0.5,0.75,1"}
   for k, v in pairs(p) do given[k] = v end
   params = given
   return dofile(asperity.scripts_dir .. "/joint.lua")
@@ -67,10 +67,44 @@ assert(fr.energy_shares and math.abs(fr.energy_balance_error) < 0.01,
        ("fracture: energy balance error %.3g of the input work"):format(fr.energy_balance_error))
 assert(fr.normal_stress_deviation_p95 <= 0.01, "fracture: the servo holds the normal stress")
 for _, f in ipairs{"summary.json", "shear.csv", "shear.h5", "closure.csv", "closure.h5", "joint.xdmf",
-                   "shear_stress.png", "dilatancy.png", "closure.png", "energies.png", "contact_map.png"} do
+                   "joint_closure.xdmf", "shear_stress.png", "normal_stress.png", "closure.png", "energies.png",
+                   "contacts.png", "contact_map.png", "contact_map_peak.png"} do
   local fh = io.open(out .. "/S1_elastic/" .. f)
   assert(fh, "missing " .. f)
   fh:close()
+end
+-- What a reader needs in the files: the stress units and scale, the run's parameters, closure in
+-- mm; snapshots indexed by shear displacement in mm, with displacement, force and angular velocity
+-- per particle, the keys of group and tag, and no particle left out of the specimen.
+do
+  local dir = out .. "/S1_elastic/"
+  assert(asperity.h5_attribute(dir .. "shear.h5", "/shear_stress_mpa", "units") == "MPa (scaled to rock)")
+  assert(asperity.h5_attribute(dir .. "shear.h5", "/shear_stress", "units") == "Pa (model)")
+  assert(asperity.h5_attribute(dir .. "shear.h5", "/", "stress_scale") == el.stress_scale, "stress_scale attribute")
+  assert(asperity.h5_attribute(dir .. "shear.h5", "/", "parameter_surface") == "S1", "parameters as attributes")
+  assert(asperity.h5_attribute(dir .. "closure.h5", "/closure", "units") == "mm", "closure in mm")
+  local closure = asperity.read_h5(dir .. "closure.h5", "/closure")
+  assert(math.abs(closure[#closure] - el.closure_mm) < 1e-12 and el.closure_mm > 0 and el.closure_mm < 1,
+         ("closure %.4g mm"):format(el.closure_mm))
+  local xdmf = assert(io.open(dir .. "joint.xdmf")):read("a")
+  assert(xdmf:find('Information Name="time" Value="shear displacement (mm)"', 1, true), "XDMF time label")
+  local times = {}
+  for t in xdmf:gmatch('<Time Value="([^"]+)"') do times[#times + 1] = tonumber(t) end
+  assert(#times == 4 and times[1] == 0 and times[4] >= 1 - 1e-9 and times[4] < 1.05,
+         "XDMF times are the shear displacements of the snapshots (0, 0.5 ... 1 mm)")
+  for _, name in ipairs{"displacement", "force", "angular_velocity", "tag"} do
+    assert(xdmf:find('Attribute Name="' .. name .. '"', 1, true), "XDMF attribute " .. name)
+  end
+  local last = dir .. "joint_000003.h5"
+  assert(asperity.h5_attribute(last, "/particles", "tag_key") == "1: lower half, 2: upper half")
+  assert(asperity.h5_attribute(last, "/particles", "group_key"):find("upper platen", 1, true))
+  local tags = asperity.read_h5(last, "/particles/tag")
+  assert(#tags == el.n_particles, ("%d particles in the snapshot, %d in the specimen"):format(#tags, el.n_particles))
+  for i = 1, #tags do assert(tags[i] == 1 or tags[i] == 2, "a left-out particle in the snapshot") end
+  local u = asperity.read_h5(last, "/particles/displacement")
+  local moved = 0
+  for i = 1, #tags do if tags[i] == 2 then moved = math.max(moved, -u:get(i, 1)) end end
+  assert(moved > 0.9e-3, ("the upper half moved %.3g m along -x"):format(moved))
 end
 -- stop_after=packing: the packed halves, before bonding, saved; nothing else run or written.
 local packed_file = out .. "/packed_only.h5"

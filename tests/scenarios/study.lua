@@ -109,7 +109,7 @@ status, log = run(("surfaces=S1 stresses=14 directions=x,y models=rigid jobs=2 t
                    "joint='overlap_limit=-1'"):format(bad), out .. "/bad.log")
 assert(status == 2, ("two failed runs: exit status %d, want 2\n%s"):format(status, log))
 for _, row in ipairs(json.read(bad .. "/study.json").runs) do
-  assert(row.status == "failed" and row.message:find("overlap_limit must be > 0, got %-1"), row.name .. ": " .. row.message)
+  assert(row.status == "failed" and row.message:find("joint.lua: parameter overlap_limit=%-1: must be > 0", 1), row.name .. ": " .. row.message)
 end
 assert(log:find("FAILED S1_14_y_rigid_s1", 1, true), "the failure is reported:\n" .. log)
 -- Failed runs are kept (not rerun) unless retry=true.
