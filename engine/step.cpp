@@ -457,6 +457,8 @@ void step_once(State& s) {
   }
   ++s.step;
   s.time += s.dt;
+  // A fixed dt near the largest double (allowed above the estimate) overflows the clock.
+  if (!std::isfinite(s.time)) health_error(s, "the simulated time overflowed (time step too large)", -1, "time", s.time);
   bookkeep(s);
   process_breaks(s);  // after the step: broken bonds acted with the forces of their last state
   s.kinetic_valid = true;

@@ -104,3 +104,19 @@ TEST(Robustness, NoCycleSucceedsWhileAStoppedStepsNaNIsLeft) {
     EXPECT_NE(std::string(e.what()).find("still holds the non-finite values"), std::string::npos) << e.what();
   }
 }
+
+// A fixed time step near the largest double, allowed above the estimate: the clock overflows and
+// the step stops instead of returning with time = inf.
+TEST(Robustness, AClockThatOverflowsStopsTheStep) {
+  WorldSettings ws;
+  ws.allow_dt_above_estimate = true;
+  World w(ws);
+  w.add_particle({0, 0, 0}, 1e-3);
+  w.set_dt(1.7e308);
+  try {
+    w.cycle(3);
+    FAIL() << "time = " << w.time();
+  } catch (const HealthError& e) {
+    EXPECT_EQ(e.quantity, "time");
+  }
+}
