@@ -6,6 +6,7 @@
 --   build/asperity run scripts/study.lua surfaces=S1,S4,S5 directions=x jobs=2 threads=1 out=out/s
 --   build/asperity run scripts/study.lua collect=true out=out/s            -- tables and report again
 --   build/asperity run scripts/study.lua slurm=study.sbatch out=/scratch/s -- a Slurm job array
+--   build/asperity run scripts/study.lua --help                            -- the parameters
 --
 -- Every run is a child process `asperity run scripts/joint.lua ... out=DIR/NAME.part` started by
 -- DIR/.study/run.sh, which renames the folder to DIR/NAME once the run has written its summary
@@ -20,86 +21,82 @@
 -- trends.md, plots/*.png, and events/ (scenarios.md 8). Exit status: the number of asked runs not
 -- finished (failed or interrupted; at most 100).
 local json = require("json")
+local params_lib = require("params")
 
-local P = require("params").defaults{
-  surfaces = "S1,S2,S3,S4,S5,S6,S7,S8",
-  stresses = "14,21",         -- normal stresses, MPa (scaled)
-  directions = "x,y",
-  models = "rigid,elastic,fracture",
-  seeds = "1",                -- surface realisations (one phase field per seed, shared by S1..S8)
-  size = 0,                   -- side of the joints, m (0: joint.lua's default)
-  normal_stiffness = 0,       -- MPa/mm: constant normal stiffness (0: constant normal load)
-  events_every = 100,         -- steps between the energy samples of the fracture runs (event statistics; 0: none)
-  joint = "",                 -- more key=value parameters for every joint.lua run, space-separated
-  out = "out/study",
-  jobs = 0,                   -- runs at once (0: the machine's cores / threads)
-  threads = 0,                -- threads of each run (0: the cores / jobs, at least 1)
-  retry = false,              -- true: runs that failed before are run again
-  collect = false,            -- true: only rebuild the tables and the report from DIR's folders
-  slurm = "",                 -- a file: write a Slurm job-array script for the runs instead of running
-  report = true,              -- false: tables only (no trends, plots, event statistics)
-  asperity = "",              -- the program each run uses (default: the one running this script)
-  poll = 0.5,                 -- s between looks at the running jobs
-  heartbeat = 600,            -- s between progress lines while runs go on (0: only at starts and ends)
+-- What the runner sets on every joint.lua command line itself: not to be given again through `joint`.
+local RESERVED = {surface = true, stress = true, direction = true, model = true, seed = true, out = true,
+                  threads = true, cache = true, size = true, progress = true, normal_control = true,
+                  normal_stiffness = true, events_every = true}
+-- The ones the study varies, each with the study's own list parameter.
+local VARIED = {surface = "surfaces", stress = "stresses", direction = "directions", model = "models", seed = "seeds"}
+
+local P = params_lib.parse{
+  script = "study.lua",
+  path = "scripts/study.lua",
+  about = "closure + shear runs of joint.lua over surfaces x stresses x directions x models x seeds, " ..
+          "resumable; one table, a trend report, plots, event statistics",
+  {"surfaces", "S1,S2,S3,S4,S5,S6,S7,S8", list = "string", oneof = {"S1", "S2", "S3", "S4", "S5", "S6", "S7", "S8"},
+   doc = "the generated surfaces"},
+  {"stresses", "14,21", list = "number", unit = "MPa", above = 0, doc = "normal stresses, scaled to rock"},
+  {"directions", "x,y", list = "string", oneof = {"x", "y"}, doc = "shear directions"},
+  {"models", "rigid,elastic,fracture", list = "string", oneof = {"rigid", "elastic", "fracture"},
+   doc = "particle models"},
+  {"seeds", "1", list = "number", min = 1, doc = "surface realisations, whole numbers (one phase field per seed, " ..
+   "shared by S1..S8; the packing uses the same seed)"},
+  {"size", 0, unit = "m", min = 0, doc = "side of the joints (0: joint.lua's default)"},
+  {"normal_stiffness", 0, unit = "MPa/mm", min = 0,
+   doc = "> 0: every run under constant normal stiffness (normal_control=stiffness); 0: constant normal load"},
+  {"events_every", 100, type = "integer", unit = "steps", min = 0,
+   doc = "between the energy samples of the fracture runs, for the event statistics (0: none)"},
+  {"joint", "", doc = "more key=value parameters for every joint.lua run, space-separated (not those the study sets)"},
+  {"out", "out/study", nonempty = true, doc = "the study's folder (one study per folder)"},
+  {"jobs", 0, type = "integer", min = 0, doc = "runs at once (0: the machine's cores / threads)"},
+  {"threads", 0, type = "integer", min = 0, doc = "threads of each run (0: the cores / jobs, at least 1)"},
+  {"retry", false, doc = "true: runs that failed before are run again"},
+  {"collect", false, doc = "true: only rebuild the tables and the report from out's folders"},
+  {"slurm", "", doc = "a file: write a Slurm job-array script for the runs instead of running them"},
+  {"report", true, doc = "false: tables only (no trends, plots, event statistics)"},
+  {"asperity", "", file = true, doc = "the program each run uses (\"\": the one running this script)"},
+  {"poll", 0.5, unit = "s", above = 0, doc = "between looks at the running jobs"},
+  {"heartbeat", 600, unit = "s", min = 0, doc = "between progress lines while runs go on (0: only at starts and ends)"},
+  notes = "A folder out/NAME is a finished run; rerunning the same command skips it (see scripts/README.md, \"The study\").",
+  check = function(P, fail)
+    -- The lists: not empty, no item twice, seeds whole numbers.
+    for _, name in ipairs{"surfaces", "stresses", "directions", "models", "seeds"} do
+      local items = params_lib.split(P[name], name == "stresses" or name == "seeds")
+      if #items == 0 then fail(name, "must name at least one") end
+      local seen = {}
+      for _, v in ipairs(items) do
+        if seen[v] then fail(name, ("'%s' is listed twice"):format(tostring(v))) end
+        seen[v] = true
+        if name == "seeds" and math.tointeger(v) == nil then
+          fail(name, ("'%s' is not a whole number; seeds must be whole numbers >= 1"):format(tostring(v)))
+        end
+      end
+    end
+    for item in P.joint:gmatch("%S+") do
+      local k = item:match("^([%a_][%w_]*)=")
+      if not k then fail("joint", ("'%s' is not of the form key=value"):format(item)) end
+      if RESERVED[k] then
+        fail("joint", ("'%s' is set by the study itself (use its own parameter%s)"):format(k,
+             VARIED[k] and ("s, e.g. " .. VARIED[k] .. "=") or ""))
+      end
+    end
+  end,
 }
+if not P then return end   -- help printed
 
 local function log(fmt, ...) io.stderr:write(("[study] " .. fmt .. "\n"):format(...)) end
 local function fail(fmt, ...) error((fmt):format(...), 0) end
 
--- Parameters -----------------------------------------------------------------------------------
-local function list(name, allowed_text, check)
-  local items, seen = {}, {}
-  for item in tostring(P[name]):gmatch("[^,%s]+") do
-    local v = check(item)
-    if v == nil then fail("%s: '%s' is not allowed (allowed: %s)", name, item, allowed_text) end
-    if seen[tostring(v)] then fail("%s: '%s' is listed twice", name, item) end
-    seen[tostring(v)] = true
-    items[#items + 1] = v
-  end
-  if #items == 0 then fail("%s is empty (give a comma-separated list of %s)", name, allowed_text) end
-  return items
-end
-local surfaces = list("surfaces", "S1..S8", function(s) return s:match("^S[1-8]$") and s or nil end)
-local stresses = list("stresses", "positive numbers, MPa", function(s)
-  local v = tonumber(s)
-  return v and v > 0 and v < math.huge and v or nil
-end)
-local directions = list("directions", "x, y", function(s) return (s == "x" or s == "y") and s or nil end)
-local models = list("models", "rigid, elastic, fracture", function(s)
-  return (s == "rigid" or s == "elastic" or s == "fracture") and s or nil
-end)
-local seeds = list("seeds", "positive integers", function(s)
-  local v = math.tointeger(tonumber(s))
-  return v and v > 0 and v or nil
-end)
-for _, key in ipairs{"jobs", "threads"} do
-  if math.type(P[key]) ~= "integer" or P[key] < 0 then
-    fail("%s must be a whole number >= 0 (0: automatic), got %s", key, tostring(P[key]))
-  end
-end
-if not (P.size >= 0) then fail("size must be >= 0 m (0: joint.lua's default), got %s", tostring(P.size)) end
-if not (P.normal_stiffness >= 0 and P.normal_stiffness < math.huge) then
-  fail("normal_stiffness must be >= 0 MPa/mm (0: constant normal load), got %s", tostring(P.normal_stiffness))
-end
-if math.type(P.events_every) ~= "integer" or P.events_every < 0 then
-  fail("events_every must be a whole number of steps >= 0 (0: no energy samples), got %s", tostring(P.events_every))
-end
-if not (P.poll > 0) then fail("poll must be > 0 s, got %s", tostring(P.poll)) end
-if not (P.heartbeat >= 0) then fail("heartbeat must be >= 0 s (0: none), got %s", tostring(P.heartbeat)) end
--- What the runner sets itself may not be given again through `joint`.
-local reserved = {surface = true, stress = true, direction = true, model = true, seed = true, out = true,
-                  threads = true, cache = true, size = true, progress = true, normal_control = true,
-                  normal_stiffness = true, events_every = true}
+local surfaces = params_lib.split(P.surfaces)
+local stresses = params_lib.split(P.stresses, true)
+local directions = params_lib.split(P.directions)
+local models = params_lib.split(P.models)
+local seeds = {}
+for k, v in ipairs(params_lib.split(P.seeds, true)) do seeds[k] = math.tointeger(v) end
 local extra = {}
-for item in P.joint:gmatch("%S+") do
-  local k, v = item:match("^([%a_][%w_]*)=(.*)$")
-  if not k then fail("joint: '%s' is not of the form key=value", item) end
-  if reserved[k] then
-    fail("joint: '%s' is set by the study itself (use its own parameter%s)", k,
-         (k == "surface" or k == "stress" or k == "direction" or k == "model" or k == "seed") and "s, e.g. " .. k .. "s=" or "")
-  end
-  extra[#extra + 1] = item
-end
+for item in P.joint:gmatch("%S+") do extra[#extra + 1] = item end
 
 local function shell_quote(s)
   s = tostring(s)

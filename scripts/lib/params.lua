@@ -45,6 +45,17 @@ local function show(v)
   return tostring(v)
 end
 
+-- A number as text that reads back as the same number (a list or a name given as one number on the
+-- command line, stresses=14.125 or seed-like names): show() rounds to 6 digits for messages.
+local function exact(v)
+  if math.type(v) == "integer" then return tostring(v) end
+  for digits = 6, 17 do
+    local t = ("%." .. digits .. "g"):format(v)
+    if tonumber(t) == v then return t end
+  end
+  return ("%.17g"):format(v)
+end
+
 local function kind(e)
   if e.type then return e.type end
   if e.list then return "string" end
@@ -133,7 +144,7 @@ end
 local function check_one(script, e, v)
   local name, k = e[1], kind(e)
   if e.list then
-    if type(v) == "number" then v = show(v) end
+    if type(v) == "number" then v = exact(v) end
     if type(v) ~= "string" then refuse(script, name, v, "must be " .. allowed(e)) end
     local items, bad = M.split(v, e.list == "number")
     if not items then refuse(script, name, v, ("'%s' is not a number; must be %s"):format(bad, allowed(e))) end
@@ -165,7 +176,7 @@ local function check_one(script, e, v)
     return v
   end
   -- strings: a number given on the command line (seed-like names) is taken as its text
-  if type(v) == "number" then v = show(v) end
+  if type(v) == "number" then v = exact(v) end
   if type(v) ~= "string" then refuse(script, name, v, "must be a string") end
   if e.oneof then
     local ok = false

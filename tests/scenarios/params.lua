@@ -92,7 +92,7 @@ local function expect_refusal(script, given, name, pattern)
   checked = checked + 1
 end
 
-for _, script in ipairs{"joint.lua", "rev.lua", "calibrate_rev.lua", "surface.lua", "demo.lua"} do
+for _, script in ipairs{"joint.lua", "rev.lua", "calibrate_rev.lua", "surface.lua", "demo.lua", "study.lua"} do
   local spec = spec_of(script)
   -- The defaults pass their own checks: the script gets to its first piece of work.
   local ok, err = run(script, {})
@@ -144,6 +144,24 @@ expect_refusal("rev.lua", {platen = 0.006}, "platen", "size / 2")
 expect_refusal("rev.lua", {radius_sd = 0.2e-3}, "radius_sd", "3 SD")
 expect_refusal("rev.lua", {tests = ""}, "tests", "at least one")
 expect_refusal("surface.lua", {n = 128}, "n", "odd")
+-- The study's lists: items from their sets, none twice, not empty; seeds whole; `joint` holds
+-- key=value items and none of those the study sets on every run itself.
+expect_refusal("study.lua", {surfaces = "S1,S9"}, "surfaces", "item S9: must be one of S1, S2")
+expect_refusal("study.lua", {surfaces = "S1,S5,S1"}, "surfaces", "'S1' is listed twice")
+expect_refusal("study.lua", {surfaces = ""}, "surfaces", "at least one")
+expect_refusal("study.lua", {models = " , "}, "models", "at least one")
+expect_refusal("study.lua", {directions = "x,z"}, "directions", "item z: must be one of x, y")
+expect_refusal("study.lua", {stresses = "14,-21"}, "stresses", "item %-21: must be > 0")
+expect_refusal("study.lua", {stresses = "14, 14.0"}, "stresses", "listed twice")
+expect_refusal("study.lua", {seeds = "1,2.5"}, "seeds", "'2.5' is not a whole number")
+expect_refusal("study.lua", {seeds = 0}, "seeds", "item 0: must be >= 1")
+expect_refusal("study.lua", {jobs = -1}, "jobs", "must be an integer, >= 0")
+expect_refusal("study.lua", {threads = 1.5}, "threads", "must be an integer")
+expect_refusal("study.lua", {poll = 0}, "poll", "must be > 0 %(s%)")
+expect_refusal("study.lua", {joint = "thickness=0.003 shear"}, "joint", "'shear' is not of the form key=value")
+expect_refusal("study.lua", {joint = "stress=3"}, "joint", "'stress' is set by the study itself %(use its own parameters, e.g. stresses=%)")
+expect_refusal("study.lua", {joint = "cache=/tmp/c"}, "joint", "'cache' is set by the study itself")
+expect_refusal("study.lua", {asperity = "/no/such/asperity"}, "asperity", "no such readable file")
 -- The default snapshots follow a shorter shear (those within it and its end); given ones do not.
 do
   local parse, seen = lib.parse, nil
@@ -155,6 +173,15 @@ do
   run("joint.lua", {})
   assert(seen.snapshots == "0,1,2.5,5", "default snapshots for the default shear: " .. tostring(seen.snapshots))
   lib.parse = parse
+end
+-- A list given as one number keeps every digit (the study names and runs that stress).
+do
+  local parse, seen = lib.parse, nil
+  lib.parse = function(spec, given) seen = parse(spec, given); return seen end
+  run("study.lua", {stresses = 14.123456789, seeds = 3})
+  lib.parse = parse
+  assert(seen.stresses == "14.123456789" and seen.seeds == "3",
+         ("stresses=14.123456789 seeds=3 became %s, %s"):format(tostring(seen.stresses), tostring(seen.seeds)))
 end
 -- A value typed on the command line arrives as a string or a number; both forms of a list pass.
 for _, v in ipairs{"0,1", 1, "0, 0.5 ,1"} do
