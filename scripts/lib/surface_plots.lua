@@ -39,7 +39,8 @@ function M.structure(r, file, title)
     file = file, logx = true, logy = true,
     title = ("%s: structure function, H = %.3f (fit over %.2f..%.2f mm)")
       :format(title, r.hurst_structure.hurst, r.hurst_structure.x_min * 1e3, r.hurst_structure.x_max * 1e3),
-    x = column(n, function(i) return s.lag[i] * 1e3 end), xlabel = "lag [mm]", ylabel = "[mm^2]",
+    x = column(n, function(i) return s.lag[i] * 1e3 end), xlabel = "lag (mm)",
+    ylabel = "mean squared height difference (mm^2)",
     y = {column(n, function(i) return s.value[i] * 1e6 end),
          column(n, function(i) return 0.5 * s.value[i] * 1e6 end),
          fit_line(s.lag, r.hurst_structure, 1e6),
@@ -57,7 +58,7 @@ function M.psd(r, file, title)
     file = file, logx = true, logy = true,
     title = ("%s: radially averaged PSD, H = %.3f, roll-off length %.2f mm")
       :format(title, r.hurst_psd.hurst, r.rolloff_length * 1e3),
-    x = p.frequency, xlabel = "frequency [cycles/m]", ylabel = "PSD [m^4]",
+    x = p.frequency, xlabel = "spatial frequency (cycles/m)", ylabel = "power spectral density (m^4)",
     y = {p.psd, fit_line(p.frequency, r.hurst_psd, 1)},
     labels = {"PSD", ("fit slope %.3f = -(2 + 2H)"):format(r.hurst_psd.slope)},
   }
@@ -70,8 +71,8 @@ function M.abbott(r, file, title)
   return asperity.plot{
     file = file, title = title .. ": Abbott-Firestone curve",
     x = column(n, function(i) return a.bearing_fraction[i] * 100 end),
-    xlabel = "bearing area (share of heights >= z) [%]",
-    y = column(n, function(i) return a.height[i] * 1e3 end), labels = {"height z [mm]"},
+    xlabel = "bearing area: share of the surface at or above z (%)", ylabel = "height z (mm)",
+    y = column(n, function(i) return a.height[i] * 1e3 end), labels = {"height z"},
   }
 end
 
@@ -94,8 +95,11 @@ function M.noise(study, dir, plot)
   end
   s:write(dir .. "/noise")
   if plot then
-    s:plot{file = dir .. "/noise.png", x = "level", y = {"hurst_psd", "hurst_structure", "variance_ratio"},
-           title = "white noise of level x rms height added: measured H and s2 / s2(clean)", points = true}
+    asperity.plot{file = dir .. "/noise.png", x = s:column("level"),
+                  y = {s:column("hurst_psd"), s:column("hurst_structure"), s:column("variance_ratio")},
+                  labels = {"H from the PSD", "H from the structure function", "s2 / s2 without noise"},
+                  xlabel = "white noise added (% of the rms height)", ylabel = "H (-); variance ratio (-)",
+                  title = "measured H and variance with white noise added", points = true}
   end
 end
 
