@@ -2,7 +2,8 @@
 -- points (e.g. broken bonds).
 --
 --   local fig = require("figures")
---   fig.histogram{file = "h.png", values = {...}, bins = 40, xlabel = "sigma [Pa]", csv = "h.csv"}
+--   fig.histogram{file = "h.png", values = {...}, bins = 40, xlabel = "bond normal stress (Pa)",
+--                 ylabel = "bonds", csv = "h.csv", column = "sigma [Pa]"}   -- column: the CSV's header
 --   fig.map{file = "m.png", points = {{x, y, z, group}, ...}, groups = {"tension", "shear"},
 --           extent = {min = {..}, max = {..}}, title = "..."}
 --   fig.curves{file = "c.png", xlabel = "u [mm]", ylabel = "tau [MPa]", logx = false, logy = false,
@@ -48,7 +49,7 @@ function M.histogram(o)
   f:close()
   if o.csv then
     local c = assert(io.open(o.csv, "w"))
-    c:write(("%s,count\n"):format(o.xlabel or "value"))
+    c:write(("%s,count\n"):format(o.column or o.xlabel or "value"))
     for k = 1, bins do c:write(("%.10g,%d\n"):format(centres[k], counts[k])) end
     c:close()
   end
@@ -61,6 +62,12 @@ function M.histogram(o)
         i, quote(m.label), m.x, quote(m.color or "red"))
     end
   end
+  -- The x range holds the marks too: a mark beyond the data (a strength far above every stress)
+  -- would otherwise not be drawn.
+  local xlo, xhi = lo, hi
+  for _, m in ipairs(o.marks or {}) do xlo, xhi = math.min(xlo, m.x), math.max(xhi, m.x) end
+  local pad = 0.05 * (xhi - xlo)
+  marks = marks .. ("set xrange [%.10g:%.10g]\n"):format(xlo - pad, xhi + pad)
   gnuplot(("set terminal pngcairo noenhanced size 900,600\nset output %s\nset xlabel %s\nset ylabel %s\n" ..
            "set title %s\nset grid\nset style fill solid 0.6\nset boxwidth %.10g\n%s" ..
            "plot %s using 1:2 with boxes lc rgb \"#3060c0\" notitle\nunset output\n"):format(
