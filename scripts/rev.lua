@@ -24,7 +24,8 @@
 --    shear strain; fracture compression and tension until the stress falls to `stop_fraction` of
 --    its peak.
 --
--- Outputs in `out`: summary.json; series (HDF5 + CSV) and stress-strain PNGs per test;
+-- Outputs in `out`: summary.json; series (HDF5 + CSV, with the parameters and the calibrated
+-- stress scale as attributes) and stress-strain PNGs per test;
 -- bond_stresses.csv / .png (after wall removal); broken-bond maps (PNG + CSV) of the fracture tests;
 -- checkpoints packed.h5, elastic.h5, fracture.h5 (asperity.load continues from them).
 --
@@ -214,11 +215,13 @@ log("elastic model: %d bonds, relaxed in %d steps (ratio %.2g)", elastic_info.bo
 local function residual_stresses(w)
   local stats, sig, need = genesis.bond_stresses(w, P.tensile_strength)
   figures.histogram{file = out .. "/bond_stresses_sigma.png", values = sig, bins = 50,
-                    xlabel = "sigma [Pa]", csv = out .. "/bond_stresses_sigma_hist.csv",
-                    title = "Bond normal stress after wall removal (tension +)",
+                    xlabel = "bond normal stress (Pa, model; tension +)", ylabel = "bonds",
+                    column = "sigma [Pa (model)]", csv = out .. "/bond_stresses_sigma_hist.csv",
+                    title = "Bond normal stress after wall removal",
                     marks = {{x = P.tensile_strength, label = "st"}}}
   figures.histogram{file = out .. "/bond_stresses_strength.png", values = need, bins = 50, min = 0,
-                    xlabel = "strength to hold [Pa]", csv = out .. "/bond_stresses_strength_hist.csv",
+                    xlabel = "strength the bond needs to hold (Pa, model)", ylabel = "bonds",
+                    column = "strength_to_hold [Pa (model)]", csv = out .. "/bond_stresses_strength_hist.csv",
                     title = "Bond strength each bond needs after wall removal (elliptic criterion)",
                     marks = {{x = P.tensile_strength, label = "st"}, {x = P.tensile_strength / 3, label = "st/3"}}}
   return stats
@@ -253,6 +256,24 @@ local columns = {"step", "time [s]", "displacement [m]", "axial_stress [Pa (mode
                  "axial_strain", "lateral_strain", "strain_x", "strain_y", "shear_strain",
                  "shear_strain_layers", "broken_bonds", "slab_xx [Pa (model)]", "slab_yy [Pa (model)]", "slab_zz [Pa (model)]",
                  "slab_xz [Pa (model)]", "slab_zx [Pa (model)]"}
+-- Attributes of every series file: the test, the run's parameters (one parameter_NAME each, as
+-- joint.lua writes them) and the stress scale. The columns are model stresses; this REV's own
+-- scale to the rock (E_rock / its measured E, summary.json's stress_scale) is known only after
+-- both elastic tests, later than their files are written, so the files carry the scale of the
+-- calibrated REV of materials.lua, the one joint.lua uses, under a name that says so.
+local parameters = {}
+for name, v in pairs(P) do parameters[name] = v end   -- as given: rate_check changes P.rate later
+local function series_attributes(name)
+  local a = {test = name, rate = P.rate, size = L,
+             stress_scale_calibrated = mat.stress_scale(),
+             young_modulus_rev_calibrated = rev.young_modulus,
+             stress_units = "stress columns are model stresses, Pa (model); MPa scaled to rock = model Pa x " ..
+                            "stress_scale_calibrated / 1e6 with the calibrated REV (materials.lua, E_REV = " ..
+                            "young_modulus_rev_calibrated Pa); this REV's own scale from its measured E is " ..
+                            "stress_scale in summary.json"}
+  for k, v in pairs(parameters) do a["parameter_" .. k] = type(v) == "boolean" and tostring(v) or v end
+  return a
+end
 local function run_test(checkpoint, name, velocity, o)
   local t0 = asperity.wall_time()
   local platens, gauges = rigs[checkpoint].platens, rigs[checkpoint].gauges
@@ -263,7 +284,7 @@ local function run_test(checkpoint, name, velocity, o)
   local s0 = o.slab and specimen.slab_stress(w, zlo, zhi, area)
   local start = w:group_position(platens.top)
   local dir = velocity[1] ~= 0 and 1 or 3
-  local series = asperity.series(with(columns, {attributes = {test = name, rate = P.rate, size = L}}))
+  local series = asperity.series(with(columns, {attributes = series_attributes(name)}))
   w:set_group_velocity(platens.top, velocity)
   local peak, peak_row = 0, nil
   local last
@@ -299,6 +320,8 @@ local function run_test(checkpoint, name, velocity, o)
 end
 
 local function column(series, name) return series:column(name):flat() end
+-- Axis labels of the stress-strain plots: words and units (tension positive, as the series).
+local AXIAL_STRAIN, AXIAL_STRESS = "axial strain (-, tension +)", "axial stress (Pa, model; tension +)"
 
 -- Linear fits over the part of the test beyond 20 % of its final strain (the start-up of the
 -- platen is left out).
@@ -324,7 +347,8 @@ local function elastic_axial(name, sign, checkpoint)
   local nu_c = (sl - sz * rl) / (sz + sl - 2 * sl * rl)
   local E_c = sz - 2 * nu_c * sl
   s:plot{file = out .. "/" .. name .. ".png", x = "axial_strain", y = {"axial_stress"},
-         title = ("%s: E = %.4g Pa, nu = %.3f"):format(name, E, nu)}
+         xlabel = AXIAL_STRAIN, ylabel = AXIAL_STRESS,
+         title = ("%s: E = %.4g Pa (model), nu = %.3f"):format(name:gsub("_", " "), E, nu)}
   log("%-20s E = %.4g Pa (R2 %.5f), nu = %.4f; slab-corrected E = %.4g Pa, nu = %.4f  [%d steps, %.1f s]",
       name, E, r2, nu, E_c, nu_c, r.steps, r.seconds)
   return {young_modulus_pa = E, poisson_ratio = nu, young_modulus_slab_pa = E_c, poisson_ratio_slab = nu_c,
@@ -390,7 +414,8 @@ if want.shear then
     local G_sym = specimen.fit_line(x, sym, keep)
     local G_slab_zx = specimen.fit_line(x, z, keep)
     s:plot{file = out .. "/shear.png", x = "shear_strain", y = {"shear_stress"},
-           title = ("direct shear: G = %.4g Pa"):format(G)}
+           xlabel = "shear strain (-)", ylabel = "shear stress (Pa, model)",
+           title = ("direct shear: G = %.4g Pa (model)"):format(G)}
     shear = {shear_modulus_pa = G, shear_modulus_layers_pa = G_layers, shear_modulus_symmetric_pa = G_sym,
              shear_modulus_slab_pa = G_slab_zx, steps = r.steps, seconds = r.seconds}
     log("%-20s G = %.4g Pa (layers only %.4g, symmetric stress %.4g); E/2(1+nu) = %.4g, slab %.4g  [%d steps, %.1f s]",
@@ -430,7 +455,9 @@ local function fracture_test(name, sign, rate)
     end})
   local s = r.series
   s:plot{file = out .. "/" .. name .. ".png", x = "axial_strain", y = {"axial_stress"},
-         title = ("%s: peak %.4g Pa"):format(name, r.peak)}
+         xlabel = AXIAL_STRAIN, ylabel = AXIAL_STRESS,
+         title = ("%s: peak %.4g Pa (model) = %.3g MPa scaled by %s"):format(name:gsub("_", " "), r.peak,
+           mat.to_rock_mpa(r.peak, E), want.elastic and "this REV's E" or "the calibrated REV's E")}
   local counts = break_map(r.world, name, ("%s: broken bonds at the end (%d)"):format(name, r.world:break_count()))
   log("%-20s strength %.4g Pa at strain %.3g; %d bonds broken (tension %d, shear %d, compression %d)  [%d steps, %.1f s]",
       name, r.peak, r.peak_row.axial_strain, r.world:break_count(), counts.tension, counts.shear,

@@ -32,6 +32,16 @@ for _, f in ipairs{"summary.json", "bond_stresses.csv", "bond_stresses_strength.
   local fh = assert(io.open(out .. "/" .. f), "missing " .. f)
   fh:close()
 end
+-- Every series file carries the calibrated stress scale (named as such: this REV's own is known
+-- only after its elastic tests) and the run's parameters, the rate as given.
+for _, f in ipairs{"elastic_compression.h5", "fracture_tension.h5"} do
+  local function attr(name) return asperity.h5_attribute(out .. "/" .. f, "/", name) end
+  assert(attr("stress_scale_calibrated") == mat.stress_scale(), f .. ": stress_scale_calibrated")
+  assert(attr("stress_units"):find("Pa (model)", 1, true), f .. ": stress_units")
+  assert(attr("parameter_seed") == cal.seeds[1] and attr("parameter_tests") == "elastic,compression,tension",
+         f .. ": the parameters as attributes")
+  assert(attr("parameter_lock_rotation") == "true", f .. ": a boolean parameter as text")
+end
 print(("E_REV %.4g Pa, nu %.3f, tensile %.3f MPa, compressive %.2f MPa, sc/st %.2f; worst bond %.3f st")
       :format(s.young_modulus_pa, s.poisson_ratio, s.tensile_strength_mpa, s.compressive_strength_mpa,
               s.strength_ratio, s.bond_stress_max_over_st))
