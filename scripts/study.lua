@@ -159,14 +159,7 @@ if jobs == 0 and threads == 0 then threads = 1 end
 if jobs == 0 then jobs = math.max(1, cores // threads) end
 if threads == 0 then threads = math.max(1, cores // jobs) end
 
--- The shortest decimal that reads back as the same double.
-local function number_text(v)
-  for digits = 6, 17 do
-    local t = ("%." .. digits .. "g"):format(v)
-    if tonumber(t) == v then return t end
-  end
-  return ("%.17g"):format(v)
-end
+local number_text = params_lib.exact   -- the shortest decimal that reads back as the same number
 
 -- The command line of one run: the same string here and in the Slurm script.
 local function command(run)

@@ -87,6 +87,7 @@ local function allowed(e)
   return text
 end
 M.allowed = allowed
+M.exact = exact   -- a number as the shortest text that reads back as the same number
 
 -- The allowed values with the unit, for messages: "> 0 (MPa)".
 local function allowed_with_unit(e)
