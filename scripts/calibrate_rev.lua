@@ -31,7 +31,7 @@ local P = params_lib.parse{
   {"bond_radius_factor", mat.rev.bond_radius_factor, above = 0, max = 1, doc = "passed to rev.lua"},
   {"rotation_lock_bonds", mat.rev.rotation_lock_bonds, type = "integer", min = 1, doc = "passed to rev.lua"},
   {"bond_gap", 0, unit = "m", min = 0, doc = "passed to rev.lua"},
-  {"genesis_stress", mat.genesis.stress, unit = "Pa", min = 0, doc = "passed to rev.lua"},
+  {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "passed to rev.lua"},
   {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "passed to rev.lua"},
   {"out", "out/calibration", nonempty = true, doc = "output folder (one folder per trial and seed)"},
   {"cache", "", doc = "packings cached here (\"\": out/cache)"},

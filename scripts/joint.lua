@@ -70,7 +70,7 @@ local P = params_lib.parse{
   {"gap", 1e-3, unit = "m", min = 0, doc = "between the halves while they relax"},
   {"platen", 1.5e-3, unit = "m", above = 0, doc = "layer of each outer face that forms a platen"},
   {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "thesis definition [3-35]: the particle count of the genesis"},
-  {"genesis_stress", mat.genesis.stress, unit = "Pa", min = 0, doc = "isotropic stress installed before bonding (scenarios.md 1; model units)"},
+  {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "isotropic stress installed before bonding (scenarios.md 1; model units)"},
   {"bond_gap", 0, unit = "m", min = 0, doc = "largest gap bonded (0: the engine's default, 1e-3 x mean radius)"},
   {"wall_friction", 0, min = 0, doc = "of the box walls and the mould during the genesis (scenarios.md 1: frictionless)"},
   {"seed", 1, type = "integer", min = 0, doc = "of the surface and the packing"},

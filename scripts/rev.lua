@@ -59,7 +59,7 @@ local P = params_lib.parse{
   {"friction", mat.contact.friction, min = 0, doc = "contact friction coefficient"},
   {"damping", mat.damping, min = 0, below = 1, doc = "local damping"},
   {"density", mat.density, unit = "kg/m^3", above = 0, doc = "particle density"},
-  {"genesis_stress", mat.genesis.stress, unit = "Pa", min = 0, doc = "isotropic stress the genesis installs before bonding (model units)"},
+  {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "isotropic stress the genesis installs before bonding (model units)"},
   {"floater_contacts", mat.genesis.floater_contacts, type = "integer", min = 0,
    doc = "particles with fewer contacts are taken out"},
   {"tensile_strength", rev.bond_tensile_strength, unit = "Pa", above = 0,
