@@ -51,7 +51,8 @@ local P = params_lib.parse{
   {"shear", 5, unit = "mm", above = 0, doc = "shear displacement"},
   {"residual_window", 0.5, unit = "mm", above = 0, doc = "the residual stress is the mean over the last this much of the shear"},
   {"velocity", 1.5e-5, unit = "m/s", above = 0, doc = "shear velocity (perf/runtime_vs_error.lua: within 1 % of a 2x slower run)"},
-  {"ramp", 0.05, unit = "mm", min = 0, doc = "the shear velocity rises linearly from 0 over this displacement"},
+  {"ramp", 0.05, unit = "mm", min = 0,
+   doc = "the shear velocity, and the upper half's approach, rise linearly from 0 over this displacement"},
   {"quasi_static_limit", 0.01, above = 0, doc = "warn when the kinetic energy exceeds this x normal load x mean radius"},
   {"overlap_limit", 0.5, above = 0, max = 1,
    doc = "warn when a contact overlaps this fraction of the smaller radius (the engine stops at 1)"},
@@ -69,6 +70,12 @@ local P = params_lib.parse{
   {"approach_gap", 0.2e-3, unit = "m", min = 0, doc = "smallest gap left between the halves after lowering the upper one"},
   {"gap", 1e-3, unit = "m", min = 0, doc = "between the halves while they relax"},
   {"platen", 1.5e-3, unit = "m", above = 0, doc = "layer of each outer face that forms a platen"},
+  {"box", "sides", oneof = {"sides", "none"},
+   doc = "sides: the layer of the four side faces joins its half's platen (a shear box) up to box_clearance "
+         .. "from the joint; none: the platens are the top and bottom layers only, the sides are free"},
+  {"box_clearance", 1e-3, unit = "m", min = 0,
+   doc = "the shear box's sides stop this far below (lower half) or above (upper half) the highest (lowest) "
+         .. "point of their half's surface within this distance"},
   {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "thesis definition [3-35]: the particle count of the genesis"},
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "isotropic stress installed before bonding (scenarios.md 1; model units)"},
   {"bond_gap", 0, unit = "m", min = 0, doc = "largest gap bonded (0: the engine's default, 1e-3 x mean radius)"},
@@ -420,6 +427,21 @@ end
 local zlo, zhi = math.huge, -math.huge
 for _, id in ipairs(lower) do zlo = math.min(zlo, pos[id][3]) end
 for _, id in ipairs(upper) do zhi = math.max(zhi, pos[id][3]) end
+-- The highest point of the lower half's surface (upper_side: the lowest of the upper half's) within
+-- `within` of (x, y), from the profilometer.
+local lo_s, up_s = prof_lower.surface, prof_upper.surface
+local function local_extreme(s, x, y, within, upper_side)
+  local best = upper_side and math.huge or -math.huge
+  local i0, j0 = math.floor(x / h) + 1, math.floor(y / h) + 1
+  local k = math.ceil(within / h)
+  for j = math.max(1, j0 - k), math.min(ny, j0 + k) do
+    for i = math.max(1, i0 - k), math.min(nx, i0 + k) do
+      local z = s:at(i, j)
+      if z == z then best = upper_side and math.min(best, z) or math.max(best, z) end
+    end
+  end
+  return best
+end
 local bottom, top
 if P.model == "rigid" then
   world:remove_bonds()
@@ -430,26 +452,13 @@ if P.model == "rigid" then
   -- over the neighbourhood it could slide under) can never be touched.
   local reach = 4 * mat.packing.mean_radius * 1.6
   local inert = {}
-  local lo_s, up_s = prof_lower.surface, prof_upper.surface
-  local function local_extreme(s, x, y, upper_side)
-    local best = upper_side and math.huge or -math.huge
-    local i0, j0 = math.floor(x / h) + 1, math.floor(y / h) + 1
-    local k = math.ceil(reach / h)
-    for j = math.max(1, j0 - k), math.min(ny, j0 + k) do
-      for i = math.max(1, i0 - k), math.min(nx, i0 + k) do
-        local z = s:at(i, j)
-        if z == z then best = upper_side and math.min(best, z) or math.max(best, z) end
-      end
-    end
-    return best
-  end
   for _, id in ipairs(lower) do
     local p = pos[id]
-    if p[3] + rad[id] < local_extreme(lo_s, p[1], p[2], false) - reach then inert[#inert + 1] = id end
+    if p[3] + rad[id] < local_extreme(lo_s, p[1], p[2], reach, false) - reach then inert[#inert + 1] = id end
   end
   for _, id in ipairs(upper) do
     local p = pos[id]
-    if p[3] - rad[id] > local_extreme(up_s, p[1], p[2], true) + reach then inert[#inert + 1] = id end
+    if p[3] - rad[id] > local_extreme(up_s, p[1], p[2], reach, true) + reach then inert[#inert + 1] = id end
   end
   if #inert > 0 then world:set_inert(inert) end
   log("rigid model: %d of %d particles inert", #inert, N)
@@ -474,9 +483,33 @@ else
     end
     world:set_bond_strength{tensile_strength = st}
   end
+  -- Platens: the layer of each outer face. With the shear box, the side faces' layers too: a half
+  -- whose sides are free carries the shear through its bulk as shear stress, and at a peak of
+  -- 1.2-1.6 sigma_n (reference.md 2) the principal tension, sigma_n/2 - sqrt((sigma_n/2)^2 + tau^2),
+  -- exceeds the material's tensile strength (at 14 MPa, from tau = 11.7 MPa on): the halves fail in
+  -- their bulk, not at the joint. A box carries the shear into the halves as side pressure. Its
+  -- sides stop short of the joint so that the halves touch only through bonded material.
+  local function on_side(p)
+    return p[1] < P.platen or p[1] > Lx - P.platen or p[2] < P.platen or p[2] > Ly - P.platen
+  end
+  local c = P.box_clearance
   local bottom_ids, top_ids = {}, {}
-  for _, id in ipairs(lower) do if pos[id][3] < zlo + P.platen then bottom_ids[#bottom_ids + 1] = id end end
-  for _, id in ipairs(upper) do if pos[id][3] > zhi - P.platen then top_ids[#top_ids + 1] = id end end
+  for _, id in ipairs(lower) do
+    local p = pos[id]
+    if p[3] < zlo + P.platen or (P.box == "sides" and on_side(p)
+                                 and p[3] + rad[id] < local_extreme(lo_s, p[1], p[2], c, false) - c) then
+      bottom_ids[#bottom_ids + 1] = id
+    end
+  end
+  for _, id in ipairs(upper) do
+    local p = pos[id]
+    if p[3] > zhi - P.platen or (P.box == "sides" and on_side(p)
+                                 and p[3] - rad[id] > local_extreme(up_s, p[1], p[2], c, true) + c) then
+      top_ids[#top_ids + 1] = id
+    end
+  end
+  log("platens: %d particles below, %d above (%s)", #bottom_ids, #top_ids,
+      P.box == "sides" and "bottom and top layers and the shear box's sides" or "bottom and top layers")
   bottom = world:add_group(bottom_ids, {translation = "fixed"})
   top = world:add_group(top_ids, {translation = {"fixed", "fixed", "velocity"}, velocity = {0, 0, 0}})
 end
@@ -495,10 +528,20 @@ end
 
 -- 5. Assembly: bring the halves together until exactly one contact exists [4.2.1] ------------
 local function between() return world:contact_summary(LOWER, UPPER, POROSITY) end
-world:set_group_motion(top, {velocity = {0, 0, -P.closure_velocity}})
+-- The upper half does not stop at the first contact, and its velocity rises from 0 over `ramp`
+-- of travel: a platen set moving at the closure velocity in one step sends a wave through the
+-- soft bonded half whose force, sqrt(k m) v, is of the order of a bond's strength.
+local ramp_steps = P.ramp > 0 and math.max(1, math.ceil(2 * P.ramp * 1e-3 / P.closure_velocity / world:dt())) or 0
+local moved_steps = 0
+local function approach_velocity(w, steps_done)
+  moved_steps = moved_steps + steps_done
+  local f = moved_steps >= ramp_steps and 1 or moved_steps / ramp_steps
+  w:set_group_velocity(top, {0, 0, -P.closure_velocity * f})
+end
+approach_velocity(world, ramp_steps > 0 and 1 or 0)
 local steps = world:run{steps = 10000000, every = 1, progress = P.progress,
+                        callback = function(w) if moved_steps < ramp_steps then approach_velocity(w, 1) end end,
                         stop_when = function(w) return w:contact_summary(LOWER, UPPER).count >= 1 end}
-world:set_group_motion(top, {velocity = {0, 0, 0}})
 log("halves in contact after %d steps", steps)
 
 -- 6. Closure at constant velocity to the normal stress [thesis 4.2.2] -----------------------
@@ -537,11 +580,13 @@ local function record_closure()
   closure:record(1e3 * d, 1e3 * (d - s * height / rev.young_modulus), s, mpa(s), c.count,
                  100 * c.area / area, world:break_count(), world:time())
 end
-world:set_group_motion(top, {velocity = {0, 0, -P.closure_velocity}})
 local closure_every = P.closure_every > 0 and P.closure_every or (P.model == "rigid" and 1 or 50)
 record_closure()
 world:run{steps = 10000000, every = 1, progress = P.progress,
-          callback = function(w) if w:step() % closure_every == 0 then record_closure() end end,
+          callback = function(w)
+            if moved_steps < ramp_steps then approach_velocity(w, 1) end
+            if w:step() % closure_every == 0 then record_closure() end
+          end,
           stop_when = function() return normal_stress() >= target_stress end,
           fraction = function() return normal_stress() / target_stress end,
           show = function()
