@@ -226,6 +226,7 @@ std::int64_t World::add_particles(std::span<const double> xyz, std::span<const d
     p.index_of_id.push_back(std::int64_t(i));
   }
   s.user_rotation_locked.resize(p.n, 0);
+  s.bonds_broken.resize(p.n, 0);
   s.partner_start.resize(p.n + 1, s.partner_start.empty() ? 0 : s.partner_start.back());
   s.any_rotating = s.any_rotating || s.settings.rotation;
   // Bond and pair padding point at null particles, whose indices moved with the new count.
@@ -770,6 +771,7 @@ void World::remove_bonds() {
   State& s = *state_;
   s.bonds.resize(0);
   s.frozen_bonds.resize(0);
+  s.bonds_broken.assign(s.p.n, 0);  // no bond left, none counts as broken
   detail::refresh_bond_topology(s);
   touch(s);  // the freed pairs enter the contact list at the next rebuild
   s.reference_energy = -1;

@@ -24,11 +24,12 @@ namespace asperity {
 namespace {
 
 using detail::State;
-constexpr int kCheckpointVersion = 6;  // 2: servo integral and integral time, group damping;
+constexpr int kCheckpointVersion = 7;  // 2: servo integral and integral time, group damping;
                                        // 3: rest overlaps (stress-free bonds);
                                        // 4: meshes' candidates within half the skin;
                                        // 5: a header with a checksum in the HDF5 user block;
-                                       // 6: rotation_lock_bonds
+                                       // 6: rotation_lock_bonds;
+                                       // 7: bonds broken per particle
 
 // The file's kind in the header of its HDF5 user block (io::h5::file_image), whose checksum is
 // verified before HDF5 parses the file: HDF5 does not survive every corruption of its metadata.
@@ -202,6 +203,9 @@ void visit(Io& io, State& s) {
   io.column("particles/id", p.id);
   io.column("particles/index_of_id", p.index_of_id);
   io.column("particles/user_rotation_locked", s.user_rotation_locked);
+  // Older files: no break counted (a damaged particle of theirs is locked again while bonded).
+  if (io.version >= 7) io.column("particles/bonds_broken", s.bonds_broken);
+  else s.bonds_broken.assign(s.p.n, 0);
 
   // Pairs with their history, and the contacts broken bonds left behind.
   for (auto [at, q] : {std::pair{std::string("pairs"), &s.pairs}, {std::string("inherited"), &s.inherited}}) {
@@ -423,8 +427,10 @@ void validate(const State& s, const std::string& path) {
     need(c->size() == cap, "particle columns of unequal length");
   if (p.has_applied)
     for (const AVec<double>* c : {&p.ax, &p.ay, &p.az}) need(c->size() == cap, "particles/ax, ay, az");
-  need(p.density.size() == n && p.index_of_id.size() == n && s.user_rotation_locked.size() == n,
-       "particles/density, index_of_id or user_rotation_locked");
+  need(p.density.size() == n && p.index_of_id.size() == n && s.user_rotation_locked.size() == n &&
+           s.bonds_broken.size() == n,
+       "particles/density, index_of_id, user_rotation_locked or bonds_broken");
+  for (std::size_t i = 0; i < n; ++i) need(s.bonds_broken[i] >= 0, "particles/bonds_broken");
   need(p.rotation_locked.size() == cap && p.group.size() == cap && p.tag.size() == cap &&
            p.flags.size() == cap && p.inert.size() == cap && p.id.size() == cap,
        "particle columns of unequal length");

@@ -1378,7 +1378,8 @@ void open_world(lua_State* L) {
        "dt_interval = 100, threads = 0 (automatic), simd = \"auto\" (scalar, sse4_2, avx2, avx512f;\n"
        "float: the force laws in single precision, scalar, for the run-time study),\n"
        "track_energy = true, reorder_interval = 10, lock_bonded_rotation = true,\n"
-       "rotation_lock_bonds = 1 (the lock holds while a particle has at least this many intact bonds)."},
+       "rotation_lock_bonds = 1 (a bonded particle none of whose bonds broke is locked; a damaged one\n"
+       "while it still has at least this many intact bonds)."},
       {"load", l_load, "asperity.load(path [, {threads=, simd=}]) -> World",
        "A world from a checkpoint written by world:save(path)."},
       {"bond_criterion", l_bond_criterion, "asperity.bond_criterion(sigma, tau, tensile_strength) -> f",

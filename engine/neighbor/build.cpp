@@ -299,6 +299,12 @@ void reorder(State& s, const CellGrid& g) {
     for (std::size_t i = 0; i < p.n; ++i) ul[i] = s.user_rotation_locked[order[i]];
     s.user_rotation_locked.swap(ul);
   }
+  s.bonds_broken.resize(p.n, 0);
+  {
+    std::vector<std::int32_t> lost(p.n);
+    for (std::size_t i = 0; i < p.n; ++i) lost[i] = s.bonds_broken[order[i]];
+    s.bonds_broken.swap(lost);
+  }
   refresh_bond_topology(s);
   ++s.reorders;
 }

@@ -295,6 +295,66 @@ TEST(Bonds, CriticalStepIncludesTheBondAndBondedRotationIsLocked) {
   EXPECT_THROW(w.set_angular_velocity(a, {1, 0, 0}), Error) << "locked while bonded";
 }
 
+// The rotation lock under damage (model.md 2, kernels/bonds.cpp refresh_bond_topology): a particle
+// none of whose bonds broke is locked however few it holds; a damaged one while it holds
+// rotation_lock_bonds. A star (centre with four bonds) and an arm (two bonds) lose bonds to
+// neighbours pulled away.
+TEST(Bonds, AnIntactParticleStaysLockedAndADamagedOneWhileItHoldsTheThreshold) {
+  WorldSettings ws;
+  ws.rotation_lock_bonds = 3;
+  World w(ws);
+  // The pulled neighbours are smaller: their bonds' beams are thinner, so theirs break first.
+  const double r = 0.8 * kR;
+  const auto centre = w.add_particle({0, 0, 0}, kR);
+  const auto arm = w.add_particle({2 * kR, 0, 0}, kR);     // bonded to the centre and the tip
+  const auto back = w.add_particle({-2 * kR, 0, 0}, kR);
+  const auto north = w.add_particle({0, kR + r, 0}, r);
+  const auto south = w.add_particle({0, -kR - r, 0}, r);
+  const auto tip = w.add_particle({3 * kR + r, 0, 0}, r);
+  BondMaterial bm;
+  bm.tensile_strength = 2.0;  // Pa
+  ASSERT_EQ(w.install_bonds(bm), 5u);
+  GroupMotion fixed;
+  fixed.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
+  w.add_group(std::vector<std::int64_t>{back}, fixed);
+  const int gn = w.add_group(std::vector<std::int64_t>{north}, fixed);
+  const int gs = w.add_group(std::vector<std::int64_t>{south}, fixed);
+  const int gt = w.add_group(std::vector<std::int64_t>{tip}, fixed);
+  auto locked = [](World& world, std::int64_t id) {
+    try {
+      world.set_angular_velocity(id, {0, 0, 0});
+      return false;
+    } catch (const Error&) {
+      return true;
+    }
+  };
+  auto pull = [&](int group, Vec3 v) {
+    GroupMotion m;
+    m.translation = {Dof::velocity, Dof::velocity, Dof::velocity};
+    m.velocity = v;
+    w.set_group_motion(group, m);
+    const std::size_t before = w.bond_count();
+    while (w.bond_count() == before && w.step_count() < 2000000) w.cycle(1);
+    ASSERT_EQ(w.bond_count(), before - 1);
+    w.set_group_motion(group, fixed);
+  };
+  EXPECT_TRUE(locked(w, centre));
+  EXPECT_TRUE(locked(w, arm)) << "two bonds, none broken: locked although fewer than rotation_lock_bonds";
+  pull(gt, {1e-6, 0, 0});
+  EXPECT_FALSE(locked(w, arm)) << "damaged, and its one bond is below min(3, 2 installed)";
+  pull(gn, {0, 1e-6, 0});
+  EXPECT_TRUE(locked(w, centre)) << "three of four bonds left: still the threshold";
+  pull(gs, {0, -1e-6, 0});
+  EXPECT_FALSE(locked(w, centre)) << "two of four left: below the threshold";
+  EXPECT_TRUE(locked(w, back)) << "intact: locked";
+  // A checkpoint keeps the count of broken bonds, so the loaded world locks the same particles.
+  const std::string path = ::testing::TempDir() + "/damaged_locks.h5";
+  w.save(path);
+  World loaded = World::load(path, 1, "auto");
+  EXPECT_FALSE(locked(loaded, arm)) << "the arm's broken bond is remembered (without it, its one bond would lock it)";
+  EXPECT_TRUE(locked(loaded, back));
+}
+
 TEST(Bonds, InstallationBondsEveryTouchingPairOnce) {
   World w;
   const int n = 5;
