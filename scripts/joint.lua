@@ -177,7 +177,7 @@ local T = P.thickness
 -- Both halves are made by the REV's genesis (lib/genesis.lua, scenarios.md 1) in one box split by
 -- the mould, so the joint is made of the material the REV calibrates.
 local key = ("%s_%s_n%d_h%.6g_T%.6g_p%.4g_s%d_g%.6g_k%d_gs%.4g_fc%d_l%d_b%.4g_%.4g_gap%.4g"):format(
-  P.surface_file ~= "" and P.surface_file:gsub("[^%w]", "_") or P.surface, "v7", n, h, T,
+  P.surface_file ~= "" and P.surface_file:gsub("[^%w]", "_") or P.surface, "v8", n, h, T,
   P.porosity, P.seed, P.gap, P.pack_steps, P.genesis_stress, mat.genesis.floater_contacts,
   mat.rev.rotation_lock_bonds, mat.rev.bond_shear_ratio, mat.rev.bond_radius_factor, P.bond_gap)
   .. (P.wall_friction ~= 0 and ("_f%.3g"):format(P.wall_friction) or "")
@@ -443,6 +443,7 @@ local function local_extreme(s, x, y, within, upper_side)
   return best
 end
 local bottom, top
+local platen_particles   -- lower and upper platen members (not for the rigid model: the halves are the bodies)
 if P.model == "rigid" then
   world:remove_bonds()
   bottom = world:add_group(lower, {translation = "fixed"})
@@ -508,6 +509,7 @@ else
       top_ids[#top_ids + 1] = id
     end
   end
+  platen_particles = {lower = #bottom_ids, upper = #top_ids}
   log("platens: %d particles below, %d above (%s)", #bottom_ids, #top_ids,
       P.box == "sides" and "bottom and top layers and the shear box's sides" or "bottom and top layers")
   bottom = world:add_group(bottom_ids, {translation = "fixed"})
@@ -890,6 +892,7 @@ local summary = {
   n_lower = #lower,
   n_upper = #upper,
   inert_particles = world:inert_count(),
+  platen_particles = platen_particles,
   bonds = world:bond_count(),
   stress_scale = stress_scale,
   target_stress_pa = target_stress,

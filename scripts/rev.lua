@@ -144,7 +144,7 @@ end
 local function cached_packing()
   if P.cache == "" then return make_packing() end
   asperity.mkdir(P.cache)
-  local key = ("rev_v2_L%.6g_n%.6g_s%d_r%.6g_%.6g_k%.6g_%.6g_d%.6g_%.6g_g%.6g_f%d_q%.6g"):format(P.size, P.porosity,
+  local key = ("rev_v3_L%.6g_n%.6g_s%d_r%.6g_%.6g_k%.6g_%.6g_d%.6g_%.6g_g%.6g_f%d_q%.6g"):format(P.size, P.porosity,
     P.seed, P.mean_radius, P.radius_sd, P.kn, P.ks, P.damping, P.density, P.genesis_stress, P.floater_contacts, P.ratio)
     .. (P.lock_rotation and ("_l%d"):format(P.rotation_lock_bonds) or "_free")
   local h5, rec = P.cache .. "/" .. key .. ".h5", P.cache .. "/" .. key .. ".lua"

@@ -59,14 +59,16 @@ end
 -- side by side. Near the jamming point a frictionless packing relaxes slowly; the servo follows
 -- the relaxation instead of waiting for an equilibrium at each trial factor. Done when every set
 -- is within `tolerance` of the target at `settled` updates running and the unbalanced-force
--- ratio is below `ratio`, or, where the assembly creeps along the mould without settling that
--- far, at `patience` updates running within the tolerance (the ratio reached is reported: the
--- bonds are installed in that state, and the wall removal cycles it to equilibrium).
+-- ratio is below `ratio`, or, where the assembly creeps without settling that far, at `patience`
+-- updates running within the tolerance (the ratio reached is reported: the bonds are installed in
+-- that state, and the wall removal cycles it to equilibrium). Near jamming the creep hardly moves
+-- the ratio (0.054 after 25 updates within the tolerance, 0.042 after 250, on a 2 cm joint) nor
+-- the most loaded bond after the wall removal (0.31 st, 0.29 st), so the patience is short.
 function M.install_stress(world, o)
   local sets, tags, volumes, target = o.sets, o.tags, o.volumes, o.target
   local tol, ratio = o.tolerance or 0.1, o.ratio or 1e-4
   local every, gain, max_change = o.every or 200, o.gain or 1, o.max_change or 2e-3
-  local settled_needed, patience = o.settled or 5, o.patience or 250
+  local settled_needed, patience = o.settled or 5, o.patience or 25
   local f, p, stiff = {}, {}, {}
   for k = 1, #sets do f[k] = 1 end
   local steps, updates, settled = 0, 0, 0

@@ -33,22 +33,24 @@ M.rock = {young_modulus = 30853e6, poisson_ratio = 0.187, compressive_strength =
 --   build/asperity run scripts/calibrate_rev.lua seeds=1,2,3,4,5        (2026-11-27)
 -- The micro-parameters the thesis leaves open (reference.md 1), chosen by the trials listed in
 -- scripts/README.md ("How the material was calibrated"): parallel bonds with kbs / kbn = 0.3
--- (Poisson ratio) and a rotation lock that holds while a particle keeps 3 intact bonds (the
--- strength ratio sc / st); lambda = 1 and the engine's gap tolerance. st is then the bond
+-- (Poisson ratio) and a rotation lock that, once a particle is damaged, holds while it keeps 3
+-- intact bonds (the strength ratio sc / st); lambda = 1 and the engine's gap tolerance. st is then the bond
 -- strength whose REV tensile strength, scaled by E_exp / E_REV, is 6.6 MPa on average; the
 -- figures of each packing scatter by the standard deviations of `calibration`.
 M.rev = {
-  young_modulus = 96.052,         -- Pa, E_REV (model units), mean over the packings
-  bond_tensile_strength = 0.033242, -- Pa, st of the elliptic criterion
+  young_modulus = 91.739,         -- Pa, E_REV (model units), mean over the packings
+  bond_tensile_strength = 0.031364, -- Pa, st of the elliptic criterion
   bond_shear_ratio = 0.3,         -- kbs / kbn of the parallel bonds
   bond_radius_factor = 1,         -- lambda [3-26]
-  rotation_lock_bonds = 3,        -- bonded particles do not rotate while they hold this many bonds
+  -- A bonded particle none of whose bonds broke does not rotate; a damaged one while it still
+  -- holds this many (model.md 2; kernels/bonds.cpp).
+  rotation_lock_bonds = 3,
   calibration = {seeds = {1, 2, 3, 4, 5},
-                 young_modulus_pa = {mean = 96.052, sd = 2.682},
-                 poisson_ratio = {mean = 0.18973, sd = 0.00731},
-                 tensile_strength_mpa = {mean = 6.5982, sd = 0.5330},
-                 compressive_strength_mpa = {mean = 72.823, sd = 2.237},
-                 strength_ratio = {mean = 11.092, sd = 0.909}},
+                 young_modulus_pa = {mean = 91.739, sd = 3.960},
+                 poisson_ratio = {mean = 0.18801, sd = 0.00658},
+                 tensile_strength_mpa = {mean = 6.5488, sd = 0.3614},
+                 compressive_strength_mpa = {mean = 68.271, sd = 3.655},
+                 strength_ratio = {mean = 10.432, sd = 0.406}},
 }
 
 -- Bond material for world:install_bonds: beams as stiff in tension as the contact springs

@@ -66,6 +66,15 @@ assert(fr.broken_bonds > 0, "the fracture model breaks bonds")
 assert(fr.energy_shares and math.abs(fr.energy_balance_error) < 0.01,
        ("fracture: energy balance error %.3g of the input work"):format(fr.energy_balance_error))
 assert(fr.normal_stress_deviation_p95 <= 0.01, "fracture: the servo holds the normal stress")
+-- The shear box (box=sides, the default): the side layers join the platens, except within
+-- box_clearance of the joint, where the halves touch only through bonded particles.
+local free_sides = joint{surface = "S1", model = "elastic", box = "none", shear = 0.2, snapshots = "",
+                         out = out .. "/S1_free_sides"}
+for _, half in ipairs{"lower", "upper"} do
+  local boxed, plain = el.platen_particles[half], free_sides.platen_particles[half]
+  assert(boxed > plain, ("%s platen: %d particles with the box, %d without"):format(half, boxed, plain))
+  assert(boxed < el["n_" .. half], ("%s platen: %d of %d particles, none left free"):format(half, boxed, el["n_" .. half]))
+end
 for _, f in ipairs{"summary.json", "shear.csv", "shear.h5", "closure.csv", "closure.h5", "joint.xdmf",
                    "joint_closure.xdmf", "shear_stress.png", "normal_stress.png", "closure.png", "energies.png",
                    "contacts.png", "contact_map.png", "contact_map_peak.png"} do
