@@ -68,7 +68,7 @@ assert(fr.energy_shares and math.abs(fr.energy_balance_error) < 0.01,
 assert(fr.normal_stress_deviation_p95 <= 0.01, "fracture: the servo holds the normal stress")
 -- The shear box (box=sides, the default): the side layers join the platens, except within
 -- box_clearance of the joint, where the halves touch only through bonded particles.
-local free_sides = joint{surface = "S1", model = "elastic", box = "none", shear = 0.2, snapshots = "",
+local free_sides = joint{surface = "S1", model = "elastic", box = "none", shear = 0.2, residual_window = 0.1, snapshots = "",
                          out = out .. "/S1_free_sides"}
 for _, half in ipairs{"lower", "upper"} do
   local boxed, plain = el.platen_particles[half], free_sides.platen_particles[half]
