@@ -5,7 +5,7 @@
 # using the machine, and wall-clock figures of that run are suspect).
 #
 #   perf/peers.sh [N=40] [STEPS=1000] [ROUNDS=1] [CORES="1 2"] [ENGINES="asperity lammps liggghts yade"]
-#                 [FRONT=cpp|lua] [QUIET=0]
+#                 [FRONT=cpp|lua] [QUIET=0] [GUARD=2]
 #
 # The peers' inputs are read where they live (../shared/peers/ beside the repository, or
 # PEERS=<dir>); nothing of theirs is copied here. Missing engines are installed with apt-get
@@ -17,12 +17,13 @@
 # `BUILD/asperity run perf/lattice.lua` instead of perf/lattice_bench (same scene, same numbers).
 # QUIET=s: on a shared machine, before each run wait up to s seconds for the other processes to
 # use less than a quarter of a core (measured over 2 s), so runs are not timed against a build.
+# GUARD=x: exit 1 when asperity is below x times LAMMPS at some core count (0: no check).
 set -euo pipefail
 
 for kv in "$@"; do
   case "$kv" in
-    N=*|STEPS=*|ROUNDS=*|CORES=*|ENGINES=*|BUILD=*|PEERS=*|FRONT=*|QUIET=*) export "${kv?}" ;;
-    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
+    N=*|STEPS=*|ROUNDS=*|CORES=*|ENGINES=*|BUILD=*|PEERS=*|FRONT=*|QUIET=*|GUARD=*) export "${kv?}" ;;
+    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
     *) echo "peers.sh: unknown argument '$kv' (see --help)" >&2; exit 2 ;;
   esac
 done
@@ -37,6 +38,7 @@ ENGINES=${ENGINES:-"asperity lammps liggghts yade"}
 BUILD=${BUILD:-$repo/build}
 FRONT=${FRONT:-cpp}
 QUIET=${QUIET:-0}
+GUARD=${GUARD:-2}
 PEERS=${PEERS:-$repo/../shared/peers}
 [[ -f $PEERS/in.lattice.lmp ]] || { echo "peers.sh: no peer inputs in $PEERS (set PEERS=)" >&2; exit 1; }
 PEERS=$(cd "$PEERS" && pwd)
@@ -145,7 +147,7 @@ wait_quiet() {
 # --- the runs ----------------------------------------------------------------------------------
 cpu=$(awk -F': *' '/^model name/ { print $2; exit }' /proc/cpuinfo)
 cpu=${cpu:-$(uname -m)}
-declare -A best best_cpu rates
+declare -A best best_cpu rates median
 simd=unknown
 echo "lattice n=$N ($((N * N * N)) particles), $STEPS timed steps after 200 warm-up, cores: $CORES, rounds: $ROUNDS"
 echo "cpu: $cpu ($(getconf _NPROCESSORS_ONLN) cores), load average: $(cut -d' ' -f1-3 /proc/loadavg)"
@@ -205,6 +207,8 @@ if [[ $ROUNDS -gt 1 ]]; then
         [[ -n $a && -n $p ]] && list+=$(awk -v a="$a" -v p="$p" 'BEGIN { printf "%.4f ", a / p }')
       done
       [[ -z $list ]] && continue
+      median[$e,$c]=$(echo "$list" | tr ' ' '\n' | sed '/^$/d' | sort -g | awk '{ v[NR] = $1 }
+        END { printf "%.4f", (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }')
       line+=$(echo "$list" | tr ' ' '\n' | sed '/^$/d' | sort -g | awk -v c="$c" '{ v[NR] = $1 }
         END { m = (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2
               printf "  %.2fx@%s (rounds %.2f-%.2f)", m, c, v[1], v[NR] }')
@@ -234,3 +238,23 @@ for e in $ENGINES; do
   done
 done
 echo "appended to ${csv#"$repo"/}"
+
+# The guard: asperity at least GUARD x LAMMPS on the lattice, same run, at every core count (the
+# median of the paired ratios with ROUNDS > 1, else the ratio of the two runs). GUARD=0: no check.
+status=0
+if [[ ${GUARD} != 0 && -n ${available[lammps]:-} ]]; then
+  for c in $CORES; do
+    r=${median[lammps,$c]:-}
+    if [[ -z $r && -n ${best[asperity,$c]:-} && -n ${best[lammps,$c]:-} ]]; then
+      r=$(awk -v a="${best[asperity,$c]}" -v p="${best[lammps,$c]}" 'BEGIN { printf "%.4f", a / p }')
+    fi
+    [[ -z $r ]] && continue
+    if awk -v r="$r" -v g="$GUARD" 'BEGIN { exit !(r < g) }'; then
+      printf 'guard FAILED: asperity/lammps %.2fx on %s core(s), below %sx\n' "$r" "$c" "$GUARD"
+      status=1
+    else
+      printf 'guard held: asperity/lammps %.2fx on %s core(s) (at least %sx)\n' "$r" "$c" "$GUARD"
+    fi
+  done
+fi
+exit $status
