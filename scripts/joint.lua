@@ -306,7 +306,8 @@ local function build_specimen()
     genesis_stress_reached = g.stress_reached, radius_factor = g.radius_factor, genesis_steps = g.steps,
     genesis_seconds = g.seconds, relax_steps = b.relax_steps, relax_reached = b.relax_reached,
     bonds_broken_in_relaxation = b.broken_in_relaxation, bond_stress = b.bond_stress,
-    bond_stress_max_over_st = b.bond_stress_max_over_st, wall_stress_pa = g.wall_stress_pa}
+    bond_stress_max_over_st = b.bond_stress_max_over_st, defined_state = b.defined_state,
+    wall_stress_pa = g.wall_stress_pa}
   asperity.write_json(cache_file .. ".json", record)
   local f = assert(io.open(cache_file .. ".lua.tmp", "w"))
   f:write("return " .. genesis.serialise(record) .. "\n")

@@ -51,6 +51,7 @@ for _, id in pairs(box) do ids[#ids + 1] = id end
 local b = genesis.bond(w, {sets = {g.kept}, material = mat.bond(), walls = ids})
 assert(b.bonds > 0 and b.broken_in_relaxation == 0, ("%d bonds broke when the walls went"):format(b.broken_in_relaxation))
 assert(b.bond_stress.max_over_st <= 1 / 3, ("a bond needs %.3f st to hold after the wall removal"):format(b.bond_stress.max_over_st))
+assert(b.defined_state == true, "the record says the genesis ended in the defined state")
 assert(w:settings().rotation_lock_bonds == mat.rev.rotation_lock_bonds)
 print(("genesis: %d particles, %d floaters, stress %.4g Pa, coordination %.2f, %d bonds, worst bond %.3f st")
       :format(n, g.floaters_removed, g.stress_pa, g.coordination, b.bonds, b.bond_stress.max_over_st))
