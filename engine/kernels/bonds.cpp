@@ -277,7 +277,6 @@ void process_breaks(State& s) {
     ev.released_energy = e.total - e.contact_kept;
     if (s.settings.track_energy) s.ledger.released += ev.released_energy;
     s.break_events.push_back(ev);
-    s.bonds_broken.resize(p.n, 0);
     ++s.bonds_broken[a];
     ++s.bonds_broken[b];
     // The pair enters the contact list now (the search never listed it while it was bonded),
