@@ -139,6 +139,8 @@ World::World(WorldSettings settings) : state_(std::make_unique<State>()) {
           "threads " + std::to_string(settings.threads) + " outside 0.." + std::to_string(kMaxThreads) +
               " (0: automatic)");
   require(settings.reorder_interval >= 0, "reorder_interval must be >= 0");
+  require(settings.overlap_limit > 0 && settings.overlap_limit < 2,
+          "overlap_limit must be in (0, 2) radii of the smaller body, got " + num(settings.overlap_limit));
   require(settings.rotation_lock_bonds >= 1,
           "rotation_lock_bonds must be >= 1, got " + std::to_string(settings.rotation_lock_bonds));
   require_finite(settings.gravity, "gravity");
@@ -884,6 +886,10 @@ void World::set_friction(double mu) {
   check_material(m, "set_friction");
   // Only the slip limit [3-22] changes: a shear force above mu Fn slips at the next step.
   state_->settings.contact = m;
+}
+void World::set_overlap_limit(double r) {
+  require(r > 0 && r < 2, "set_overlap_limit: " + num(r) + " outside (0, 2) radii of the smaller body");
+  state_->settings.overlap_limit = r;
 }
 void World::set_skin(double skin) {
   require(skin > 0 && skin <= kMaxCoordinate,

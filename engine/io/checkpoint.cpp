@@ -24,12 +24,13 @@ namespace asperity {
 namespace {
 
 using detail::State;
-constexpr int kCheckpointVersion = 7;  // 2: servo integral and integral time, group damping;
+constexpr int kCheckpointVersion = 8;  // 2: servo integral and integral time, group damping;
                                        // 3: rest overlaps (stress-free bonds);
                                        // 4: meshes' candidates within half the skin;
                                        // 5: a header with a checksum in the HDF5 user block;
                                        // 6: rotation_lock_bonds;
-                                       // 7: bonds broken per particle
+                                       // 7: bonds broken per particle;
+                                       // 8: overlap_limit
 
 // The file's kind in the header of its HDF5 user block (io::h5::file_image), whose checksum is
 // verified before HDF5 parses the file: HDF5 does not survive every corruption of its metadata.
@@ -157,6 +158,7 @@ void visit(Io& io, State& s) {
   io.scalar("settings/reorder_interval", ws.reorder_interval);
   io.flag("settings/lock_bonded_rotation", ws.lock_bonded_rotation);
   if (io.version >= 6) io.scalar("settings/rotation_lock_bonds", ws.rotation_lock_bonds);
+  if (io.version >= 8) io.scalar("settings/overlap_limit", ws.overlap_limit);
 
   // Clock, time step, neighbour bookkeeping, ledgers.
   io.scalar("run/step", s.step);

@@ -85,6 +85,7 @@ int world_new(lua_State* L) {
     s.reorder_interval = int_in(o.integer("reorder_interval", s.reorder_interval), "asperity.world: reorder_interval", 0, 1 << 30);
     s.lock_bonded_rotation = o.boolean("lock_bonded_rotation", s.lock_bonded_rotation);
     s.rotation_lock_bonds = static_cast<int>(o.integer("rotation_lock_bonds", s.rotation_lock_bonds));
+    s.overlap_limit = o.number("overlap_limit", s.overlap_limit);
     o.finish();
     // Construct before setting the metatable: if the constructor throws, no __gc will ever run
     // on the uninitialised block.
@@ -145,6 +146,7 @@ int world_settings(lua_State* L) {
     integer("reorder_interval", s.reorder_interval);
     boolean("lock_bonded_rotation", s.lock_bonded_rotation);
     integer("rotation_lock_bonds", s.rotation_lock_bonds);
+    num("overlap_limit", s.overlap_limit);
     return 1;
   });
 }
@@ -1336,6 +1338,9 @@ void open_world(lua_State* L) {
       {"set_dt_safety", set_world_number<&World::set_dt_safety>, "world:set_dt_safety(f)",
        "Automatic time step = f x the critical estimate (default 0.8; 0.001 <= f <= 2)."},
       {"set_skin", set_world_number<&World::set_skin>, "world:set_skin(m)", "Verlet skin in m (the list is rebuilt)."},
+      {"set_overlap_limit", set_world_number<&World::set_overlap_limit>, "world:set_overlap_limit(r)",
+       "The health check's deepest overlap, in radii of the smaller body (default 1; 0 < r < 2).\n"
+       "Deeper, one centre is inside the other particle; a rigid block's contacts may go there."},
       {"set_friction", set_world_number<&World::set_friction>, "world:set_friction(mu)",
        "Ball-ball Coulomb coefficient from the next step on (walls keep theirs)."},
       {"critical_dt", world_critical_dt, "world:critical_dt() -> s",
@@ -1379,7 +1384,8 @@ void open_world(lua_State* L) {
        "float: the force laws in single precision, scalar, for the run-time study),\n"
        "track_energy = true, reorder_interval = 10, lock_bonded_rotation = true,\n"
        "rotation_lock_bonds = 1 (a bonded particle none of whose bonds broke is locked; a damaged one\n"
-       "while it still has at least this many intact bonds)."},
+       "while it still has at least this many intact bonds), overlap_limit = 1 (the health check stops\n"
+       "a run when a contact or bond overlaps deeper than this many radii of its smaller body; < 2)."},
       {"load", l_load, "asperity.load(path [, {threads=, simd=}]) -> World",
        "A world from a checkpoint written by world:save(path)."},
       {"bond_criterion", l_bond_criterion, "asperity.bond_criterion(sigma, tau, tensile_strength) -> f",

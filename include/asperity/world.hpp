@@ -75,6 +75,8 @@ struct WorldSettings {
   bool lock_bonded_rotation = true; // a particle holding an intact bond does not rotate (model.md 2)
   int rotation_lock_bonds = 1;      // ... holding at least this many intact bonds: the restriction
                                     // ends once a particle has lost all but fewer of its bonds
+  double overlap_limit = 1.0;       // health: the deepest overlap allowed, in radii of the smaller
+                                    // body (< 2); a rigid block's contacts may pass this deep
 };
 
 // How a rigid group's degree of freedom moves (model.md 1, 7).
@@ -308,6 +310,7 @@ class World {
   void set_dt(double dt);                 // fix it (0: back to automatic)
   void set_dt_safety(double f);           // automatic dt = f x estimate (0 < f <= 2)
   void set_skin(double skin);             // Verlet skin, m (> 0); the list is rebuilt
+  void set_overlap_limit(double r);       // health check's deepest overlap / smaller radius, (0, 2)
   void set_friction(double mu);           // ball-ball Coulomb coefficient from now on (>= 0)
   double critical_dt();                   // estimate now [3-30..3-32], without safety factor
   std::uint64_t step_count() const;

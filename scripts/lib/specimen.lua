@@ -210,4 +210,28 @@ function M.fit_line(xs, ys, keep)
   return b, (sy - b * sx) / n, r2
 end
 
+-- Debris thrown out of a specimen: the particles of no rigid group, not yet tagged `tag`, whose
+-- centre lies outside `box` = {min = {x, y, z}, max = {x, y, z}}. A particle freed by bond breaks
+-- and thrown clear of every body flies on at constant speed (local damping acts on forces only):
+-- it carries nothing, yet its travel triggers the neighbour rebuilds and stretches the cell grid.
+-- They are taken out like floaters: tagged `tag`, frozen in a fixed group, inert. Returns their ids.
+function M.take_out_escaped(world, box, tag)
+  local lo, hi = box.min, box.max
+  local X = world:positions()
+  local out = {}
+  for id = 1, world:particle_count() do
+    local p = X[id]
+    if (p[1] < lo[1] or p[1] > hi[1] or p[2] < lo[2] or p[2] > hi[2] or p[3] < lo[3] or p[3] > hi[3])
+        and world:tag(id) ~= tag and not world:group_of(id) then
+      out[#out + 1] = id
+    end
+  end
+  if #out > 0 then
+    world:set_tag(out, tag)
+    world:add_group(out, {translation = "fixed"})   -- inert particles must belong to a rigid body
+    world:set_inert(out)
+  end
+  return out
+end
+
 return M

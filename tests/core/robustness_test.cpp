@@ -120,3 +120,37 @@ TEST(Robustness, AClockThatOverflowsStopsTheStep) {
     EXPECT_EQ(e.quantity, "time");
   }
 }
+
+// The health check's overlap limit: a pair pressed 1.2 radii deep stops the step under the default
+// limit (one radius) and runs under a raised one, which a checkpoint keeps.
+TEST(Robustness, AnOverlapDeeperThanTheLimitStopsTheStepAndTheLimitCanBeRaised) {
+  auto deep_pair = [] {
+    World w;
+    w.add_particle({0, 0, 0}, 1e-3);
+    w.add_particle({0.8e-3, 0, 0}, 1e-3);  // overlap 1.2e-3 = 1.2 R
+    GroupMotion held;                       // two fixed bodies: the overlap stays
+    held.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
+    const std::int64_t a[] = {0}, b[] = {1};
+    w.add_group(a, held);
+    w.add_group(b, held);
+    return w;
+  };
+  World w = deep_pair();
+  try {
+    w.cycle(200);  // the check runs with the time-step estimate, every dt_interval steps
+    FAIL() << "the step went on with an overlap of 1.2 R";
+  } catch (const HealthError& e) {
+    EXPECT_EQ(e.quantity, "overlap / R");
+    EXPECT_NEAR(e.value, 1.2, 1e-6);
+  }
+  World v = deep_pair();
+  EXPECT_EQ(error_of([&] { v.set_overlap_limit(2.0); }).rfind("set_overlap_limit: 2 outside (0, 2)", 0), 0u);
+  v.set_overlap_limit(1.5);
+  EXPECT_NO_THROW(v.cycle(200));
+  const std::string path = ::testing::TempDir() + "overlap_limit.h5";
+  v.save(path);
+  EXPECT_EQ(World::load(path).settings().overlap_limit, 1.5);
+  WorldSettings bad;
+  bad.overlap_limit = 0;
+  EXPECT_NE(error_of([&] { World x(bad); }).find("overlap_limit must be in (0, 2)"), std::string::npos);
+}
