@@ -50,6 +50,7 @@ local P = params_lib.parse{
    doc = "between the energy samples of the fracture runs, for the event statistics (0: none)"},
   {"joint", "", doc = "more key=value parameters for every joint.lua run, space-separated (not those the study sets)"},
   {"out", "out/study", nonempty = true, doc = "the study's folder (one study per folder)"},
+  {"cache", "", doc = "the folder of the packed specimens (\"\": out/cache); studies may share one"},
   {"jobs", 0, type = "integer", min = 0, doc = "runs at once (0: the machine's cores / threads)"},
   {"threads", 0, type = "integer", min = 0, doc = "threads of each run (0: the cores / jobs, at least 1)"},
   {"retry", false, doc = "true: runs that failed before are run again"},
@@ -113,6 +114,7 @@ end
 local cwd = capture("pwd")
 local function absolute(path) return path:sub(1, 1) == "/" and path or (cwd .. "/" .. path) end
 local DIR = absolute(P.out):gsub("/+$", ""):gsub("/%./", "/")
+local CACHE = P.cache ~= "" and absolute(P.cache):gsub("/+$", "") or DIR .. "/cache"
 -- The program: the one running this script ($PPID of a shell it starts), unless told.
 local exe = P.asperity ~= "" and absolute(P.asperity) or capture("readlink -f /proc/$PPID/exe")
 local joint_script = absolute(asperity.scripts_dir) .. "/joint.lua"
@@ -174,7 +176,7 @@ local function command(run)
   for _, item in ipairs(extra) do args[#args + 1] = item end
   args[#args + 1] = "threads=" .. threads
   args[#args + 1] = "progress=false"
-  args[#args + 1] = "cache=" .. DIR .. "/cache"
+  args[#args + 1] = "cache=" .. CACHE
   args[#args + 1] = "out=" .. DIR .. "/" .. run.name .. ".part"
   for k, a in ipairs(args) do args[k] = shell_quote(a) end
   return table.concat(args, " ")
