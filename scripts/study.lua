@@ -562,15 +562,17 @@ local function estimate(run, packs)
     for _, v in ipairs(t) do s = s + v end
     return s / #t
   end
-  if packs then return mean(run.model .. "+pack") or mean("any+pack") or mean(run.model) or mean("any") end
-  return mean(run.model) or mean("any") or mean(run.model .. "+pack") or mean("any+pack")
+  -- A model's own times only: a rigid run takes seconds where an elastic one takes minutes, so
+  -- another model's time would be no estimate at all.
+  if packs then return mean(run.model .. "+pack") or mean(run.model) end
+  return mean(run.model) or mean(run.model .. "+pack")
 end
 
 local running, done, failed_now = {}, 0, 0
 local last_heartbeat = asperity.wall_time()
 local function started_count() local n = 0 for _ in pairs(running) do n = n + 1 end return n end
 local function overall_left()
-  local total, known = 0, true
+  local total, known, unknown = 0, true, {}
   -- One packer for each group not packed yet (unless one is running), the others after it.
   local packing = {}
   for _, job in pairs(running) do if job.packs then packing[job.run.group] = true end end
@@ -578,14 +580,19 @@ local function overall_left()
     local packs = not ready[run.group] and not packing[run.group]
     if packs then packing[run.group] = true end
     local e = estimate(run, packs)
-    if e then total = total + e else known = false end
+    if e then total = total + e else known, unknown[run.model] = false, true end
   end
   local now = asperity.wall_time()
   for _, job in pairs(running) do
     local e = estimate(job.run, job.packs)
-    if e then total = total + math.max(0, e - (now - job.t)) else known = false end
+    if e then total = total + math.max(0, e - (now - job.t)) else known, unknown[job.run.model] = false, true end
   end
-  if not known then return "time left not known yet" end
+  if not known then
+    local names = {}
+    for m in pairs(unknown) do names[#names + 1] = m end
+    table.sort(names)
+    return ("at least %s left (no %s run finished yet)"):format(clock(total / jobs), table.concat(names, " or "))
+  end
   return "about " .. clock(total / jobs) .. " left"
 end
 
@@ -669,10 +676,8 @@ local function run_all()
       if state == "finished" then
         ready[job.run.group] = true
         local key = job.run.model .. (job.packs and "+pack" or "")
-        for _, k in ipairs{key, job.packs and "any+pack" or "any"} do
-          times[k] = times[k] or {}
-          table.insert(times[k], seconds)
-        end
+        times[key] = times[key] or {}
+        table.insert(times[key], seconds)
         local ok, s = pcall(json.read, DIR .. "/" .. name .. "/summary.json")
         local what = ok and type(s.peak_shear_stress_mpa) == "number" and type(s.residual_shear_stress_mpa) == "number"
                      and (": peak %.2f MPa, residual %.2f MPa"):format(s.peak_shear_stress_mpa, s.residual_shear_stress_mpa) or ""
