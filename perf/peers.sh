@@ -4,17 +4,25 @@
 # engine and core count; load_avg is the 1-minute load when the runs ended: above ~0.5 others were
 # using the machine, and wall-clock figures of that run are suspect).
 #
-#   perf/peers.sh [N=40] [STEPS=1000] [ROUNDS=1] [CORES="1 2"] [ENGINES="asperity lammps liggghts yade"]
-#                 [FRONT=cpp|lua] [QUIET=0] [GUARD=2]
+#   perf/peers.sh [SCENE=lattice|bonded] [N=40] [STEPS=1000] [ROUNDS=1] [CORES="1 2"]
+#                 [ENGINES="asperity lammps liggghts yade"] [FRONT=cpp|lua] [QUIET=0] [GUARD=2]
 #
-# The peers' inputs are read where they live (../shared/peers/ beside the repository, or
-# PEERS=<dir>); nothing of theirs is copied here. Missing engines are installed with apt-get
-# (Debian packages lammps, liggghts, yade, openmpi-bin) when running as root; an engine that
-# cannot be had is skipped. asperity is perf/lattice_bench from BUILD (default build/), built if
-# missing. Runs alternate between engines (asperity, lammps, liggghts, yade, then the next core
-# count, then the next round) so that a busy machine slows them alike; with ROUNDS > 1 the best of
-# the rounds is kept per engine and core count. FRONT=lua times asperity through
-# `BUILD/asperity run perf/lattice.lua` instead of perf/lattice_bench (same scene, same numbers).
+# SCENE=bonded: the bonded block instead (perf/bonded.lua and its YADE twin perf/bonded_yade.py:
+# n^3 touching spheres of the REV material, every touching pair bonded, no rotation, the top layer
+# pressed down); rows go to perf/results/<cpu-model>-bonded.csv. Only asperity and YADE run it:
+# LAMMPS and LIGGGHTS are skipped with the reason (Debian's builds have no bonded granular model),
+# FRONT and GUARD do not apply. Each run prints the bonds in the step at its start and end.
+#
+# The lattice's peer inputs are read where they live (../shared/peers/ beside the repository, or
+# PEERS=<dir>); nothing of theirs is copied here. The bonded scene's inputs are the project's own
+# (perf/). Missing engines are installed with apt-get (Debian packages lammps, liggghts, yade,
+# openmpi-bin) when running as root; an engine that cannot be had is skipped. asperity is
+# perf/lattice_bench from BUILD (default build/; BUILD/asperity for FRONT=lua and the bonded
+# scene), built if missing. Runs alternate between engines (asperity, lammps, liggghts, yade, then
+# the next core count, then the next round) so that a busy machine slows them alike; with
+# ROUNDS > 1 the best of the rounds is kept per engine and core count. FRONT=lua times asperity
+# through `BUILD/asperity run perf/lattice.lua` instead of perf/lattice_bench (same scene, same
+# numbers).
 # QUIET=s: on a shared machine, before each run wait up to s seconds for the other processes to
 # use less than a quarter of a core (measured over 2 s), so runs are not timed against a build.
 # GUARD=x: exit 1 when asperity is below x times LAMMPS at some core count (0: no check).
@@ -22,14 +30,16 @@ set -euo pipefail
 
 for kv in "$@"; do
   case "$kv" in
-    N=*|STEPS=*|ROUNDS=*|CORES=*|ENGINES=*|BUILD=*|PEERS=*|FRONT=*|QUIET=*|GUARD=*) export "${kv?}" ;;
-    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
+    SCENE=*|N=*|STEPS=*|ROUNDS=*|CORES=*|ENGINES=*|BUILD=*|PEERS=*|FRONT=*|QUIET=*|GUARD=*) export "${kv?}" ;;
+    -h|--help) sed -n '2,/^set -e/{/^set -e/!p}' "$0"; exit 0 ;;
     *) echo "peers.sh: unknown argument '$kv' (see --help)" >&2; exit 2 ;;
   esac
 done
 
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 repo=$(cd "$here/.." && pwd)
+SCENE=${SCENE:-lattice}
+case $SCENE in lattice|bonded) ;; *) echo "peers.sh: unknown SCENE '$SCENE' (lattice or bonded)" >&2; exit 2 ;; esac
 N=${N:-40}
 STEPS=${STEPS:-1000}
 ROUNDS=${ROUNDS:-1}
@@ -40,8 +50,12 @@ FRONT=${FRONT:-cpp}
 QUIET=${QUIET:-0}
 GUARD=${GUARD:-2}
 PEERS=${PEERS:-$repo/../shared/peers}
-[[ -f $PEERS/in.lattice.lmp ]] || { echo "peers.sh: no peer inputs in $PEERS (set PEERS=)" >&2; exit 1; }
-PEERS=$(cd "$PEERS" && pwd)
+if [[ $SCENE == lattice ]]; then
+  [[ -f $PEERS/in.lattice.lmp ]] || { echo "peers.sh: no peer inputs in $PEERS (set PEERS=)" >&2; exit 1; }
+  PEERS=$(cd "$PEERS" && pwd)
+else
+  FRONT=lua   # the bonded scene has only the Lua front
+fi
 work=$(mktemp -d /tmp/asperity-peers.XXXXXX)
 trap 'rm -rf "$work"' EXIT
 export OMP_NUM_THREADS=1   # the peers: MPI ranks only (Debian's LAMMPS also reads it)
@@ -56,8 +70,28 @@ apt_install() {  # package...
         --no-install-recommends "$@" >"$work/apt.log" 2>&1; }
 }
 have() { command -v "$1" >/dev/null 2>&1; }
+# Why a peer does not run the bonded scene (empty: it does). The bonded block needs breakable bonds
+# between granular spheres (normal, shear and bending stiffness, a strength); a bond style of point
+# masses (harmonic, fene, ...) is not that model, and none is put under a peer's name instead.
+no_bonded_model() {  # engine
+  case $1 in
+    lammps)
+      if have lmp && lmp -h 2>/dev/null | grep -q 'bpm/'; then
+        echo "this LAMMPS has the BPM package, but perf/ has no bonded LAMMPS scene yet"
+      else
+        echo "no bonded granular model in this LAMMPS build (no BPM package: no bond_style" \
+             "bpm/rotational, no pair_style bpm/spring; Debian's lammps 20220106 has none)"
+      fi ;;
+    liggghts) echo "LIGGGHTS-PUBLIC 3.8 has no bond styles (the cohesion models of its pair gran," \
+                   "sjkr and easo, are adhesion, not bonds)" ;;
+  esac
+}
 declare -A available
 for e in $ENGINES; do
+  if [[ $SCENE == bonded && $e != asperity && -n $(no_bonded_model "$e") ]]; then
+    echo "peers.sh: $e skipped for SCENE=bonded: $(no_bonded_model "$e")" >&2
+    continue
+  fi
   case $e in
     asperity)
       target=lattice_bench bench=$BUILD/perf/lattice_bench
@@ -95,6 +129,14 @@ cpu_rate() {  # engine log
 run_engine() {  # engine cores log
   local e=$1 c=$2 log=$3
   local rank=(); [[ $c -gt 1 ]] && rank=("${mpirun[@]}" -np "$c")
+  if [[ $SCENE == bonded ]]; then
+    case $e in
+      asperity) "$BUILD/asperity" run "$here/bonded.lua" n="$N" steps="$STEPS" threads="$c" warmup=200 >"$log" 2>&1 ;;
+      yade) (cd "$work" && yade -n -x -j"$c" "$here/bonded_yade.py" "$N" "$STEPS" warmup=200) >"$log" 2>&1 ;;
+    esac
+    awk '/^particle-steps\/s:/ { r = $2 } END { if (r > 0) print r }' "$log"
+    return
+  fi
   case $e in
     asperity)
       if [[ $FRONT == lua ]]; then
@@ -147,9 +189,13 @@ wait_quiet() {
 # --- the runs ----------------------------------------------------------------------------------
 cpu=$(awk -F': *' '/^model name/ { print $2; exit }' /proc/cpuinfo)
 cpu=${cpu:-$(uname -m)}
-declare -A best best_cpu rates median
+declare -A best best_cpu rates median bonds
 simd=unknown
-echo "lattice n=$N ($((N * N * N)) particles), $STEPS timed steps after 200 warm-up, cores: $CORES, rounds: $ROUNDS"
+if [[ $SCENE == bonded ]]; then
+  echo "bonded n=$N ($((N * N * N)) particles, every touching pair bonded), $STEPS timed steps after 200 warm-up, cores: $CORES, rounds: $ROUNDS"
+else
+  echo "lattice n=$N ($((N * N * N)) particles), $STEPS timed steps after 200 warm-up, cores: $CORES, rounds: $ROUNDS"
+fi
 echo "cpu: $cpu ($(getconf _NPROCESSORS_ONLN) cores), load average: $(cut -d' ' -f1-3 /proc/loadavg)"
 for r in $(seq 1 "$ROUNDS"); do
   for c in $CORES; do
@@ -168,6 +214,14 @@ for r in $(seq 1 "$ROUNDS"); do
       rates[$e,$c,$r]=$rate
       printf '  round %d  %-9s %d core(s)  %12.4g particle-steps/s' "$r" "$e" "$c" "$rate"
       [[ -n $crate ]] && printf '  (%.4g per CPU-second)' "$crate"
+      if [[ $SCENE == bonded ]]; then
+        b=$(awk '/^bonds in the step:/ { print $5 " -> " $9 }' "$log")
+        bonds[$e,$c,$r]=$b
+        printf '  bonds %s' "${b:-?}"
+      fi
+      # asperity's rate over this engine's, same round and core count (asperity runs first)
+      a=${rates[asperity,$c,$r]:-}
+      [[ $e != asperity && -n $a ]] && awk -v a="$a" -v p="$rate" 'BEGIN { printf "  %.3gx", a / p }'
       printf '\n'
       prev=${best[$e,$c]:-0}
       best[$e,$c]=$(awk -v a="$rate" -v b="$prev" 'BEGIN { print (a > b ? a : b) }')
@@ -216,6 +270,19 @@ if [[ $ROUNDS -gt 1 ]]; then
     echo "asperity/$e, median of the rounds' paired ratios:$line"
   done
 fi
+# The bonded scene is the same work only while the engines hold the same bonds.
+if [[ $SCENE == bonded ]]; then
+  for e in $ENGINES; do
+    [[ $e == asperity || -z ${available[$e]:-} ]] && continue
+    for c in $CORES; do
+      for r in $(seq 1 "$ROUNDS"); do
+        x=${bonds[asperity,$c,$r]:-} y=${bonds[$e,$c,$r]:-}
+        [[ -z $x || -z $y ]] && continue
+        [[ $x == "$y" ]] || echo "bonds differ, round $r, $c core(s): asperity $x, $e $y (the ratio compares unlike work)"
+      done
+    done
+  done
+fi
 a1=${best_cpu[asperity,1]:-} l1=${best_cpu[lammps,1]:-}
 if [[ -n $a1 && -n $l1 ]]; then
   awk -v a="$a1" -v l="$l1" 'BEGIN { printf "1 core, per CPU-second (robust on a busy machine): asperity %.4g, lammps %.4g, ratio %.2fx\n", a, l, a / l }'
@@ -228,6 +295,7 @@ done
 mkdir -p "$here/results"
 slug=$(echo "$cpu" | tr 'A-Z' 'a-z' | sed -e 's/([a-z]*)//g' -e 's/[^a-z0-9]\+/-/g' -e 's/^-//' -e 's/-$//')
 csv=$here/results/${slug:-$(hostname)}.csv
+[[ $SCENE == bonded ]] && csv=${csv%.csv}-bonded.csv
 [[ -s $csv ]] || echo "date,cpu_model,simd,commit,engine,engine_version,cores,n,particles,steps,particle_steps_per_s,load_avg,particle_steps_per_cpu_s" >"$csv"
 now=$(date -u +%Y-%m-%dT%H:%M:%SZ)
 load=$(cut -d' ' -f1 /proc/loadavg)
@@ -241,8 +309,9 @@ echo "appended to ${csv#"$repo"/}"
 
 # The guard: asperity at least GUARD x LAMMPS on the lattice, same run, at every core count (the
 # median of the paired ratios with ROUNDS > 1, else the ratio of the two runs). GUARD=0: no check.
+# The lattice only: the bonded scene has no guard.
 status=0
-if [[ ${GUARD} != 0 && -n ${available[lammps]:-} ]]; then
+if [[ $SCENE == lattice && ${GUARD} != 0 && -n ${available[lammps]:-} ]]; then
   for c in $CORES; do
     r=${median[lammps,$c]:-}
     if [[ -z $r && -n ${best[asperity,$c]:-} && -n ${best[lammps,$c]:-} ]]; then
