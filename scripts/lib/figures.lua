@@ -121,7 +121,7 @@ function M.map(o)
 end
 
 -- Several x-y series in one figure: lines, points or both (style "lines", "points",
--- "linespoints"); a series with no finite point is left out (a figure with none is not drawn).
+-- "linespoints", "impulses"); a series with no finite point is left out (a figure with none is not drawn).
 -- Returns true if the figure was drawn.
 function M.curves(o)
   local palette = {"#d02020", "#2050d0", "#20a040", "#e08000", "#8040c0", "#00a0a0", "#a0a000", "#606060"}
@@ -146,7 +146,7 @@ function M.curves(o)
       local spec = ("%s index %d using 1:2 with %s lw %g lc rgb %s"):format(quote(data), index, style,
         s.width or 2, quote(s.color or palette[(k - 1) % #palette + 1]))
       if s.dash then spec = spec .. " dt " .. s.dash end
-      if style ~= "lines" then spec = spec .. (" pt %d ps %g"):format(s.point or 7, s.size or 1) end
+      if style == "points" or style == "linespoints" then spec = spec .. (" pt %d ps %g"):format(s.point or 7, s.size or 1) end
       plots[#plots + 1] = spec .. " title " .. quote(s.title or "")
       index = index + 1
     end

@@ -93,7 +93,10 @@ local function compare(index, rows, field, vary, pairs_list, expect, filter)
             local ok = (expect == "up") == (b[field] > a[field])
             if ok then agree = agree + 1 end
             list[#list + 1] = {low = a.name, high = b.name, low_value = a[field], high_value = b[field],
-                               relative_change = a[field] ~= 0 and (b[field] - a[field]) / math.abs(a[field]) or 0/0,
+                               -- a base a thousand times below the other value (a fracture run's
+                               -- dilatancy of 0.000 mm) gives no meaningful ratio: left out of the mean
+                               relative_change = math.abs(a[field]) > 1e-3 * math.abs(b[field])
+                                                 and (b[field] - a[field]) / math.abs(a[field]) or 0/0,
                                agrees = ok}
           end
         end
@@ -104,7 +107,7 @@ local function compare(index, rows, field, vary, pairs_list, expect, filter)
   for _, c in ipairs(list) do if finite(c.relative_change) then changes[#changes + 1] = c.relative_change end end
   local m, sd = mean_sd(changes)
   return {verdict = verdict(agree, #list), agree = agree, comparisons = #list, mean_relative_change = m,
-          sd_relative_change = sd, pairs = list}
+          sd_relative_change = sd, vanishing_bases = #list - #changes, pairs = list}
 end
 
 local function surface_pairs(kind)
@@ -311,6 +314,9 @@ local function trends_markdown(T, rows)
       numbers[#numbers + 1] = ("mean relative change %+.1f %% (SD %.1f %%)"):format(100 * t.mean_relative_change,
         100 * (finite(t.sd_relative_change) and t.sd_relative_change or 0))
     end
+    if (t.vanishing_bases or 0) > 0 then
+      numbers[#numbers + 1] = ("%d with a vanishing base left out of the mean"):format(t.vanishing_bases)
+    end
     if t.mean_abs_relative_change then
       for _, k in ipairs{"H", "s2", "Lc"} do
         if t.mean_abs_relative_change[k] then
@@ -329,8 +335,12 @@ local function trends_markdown(T, rows)
                           {"rigid_above_elastic", "rigid above elastic"}, {"elastic_above_fracture", "elastic above fracture"}} do
       local sub = t[part[1]]
       if sub and sub.comparisons > 0 then
-        numbers[#numbers + 1] = ("%s %d / %d (mean change %+.1f %%)"):format(part[2], sub.agree, sub.comparisons,
-                                                                           100 * (sub.mean_relative_change or 0/0))
+        local change = finite(sub.mean_relative_change) and ("mean change %+.1f %%"):format(100 * sub.mean_relative_change)
+                       or "no mean change"
+        if (sub.vanishing_bases or 0) > 0 then
+          change = change .. (", %d with a vanishing base left out"):format(sub.vanishing_bases)
+        end
+        numbers[#numbers + 1] = ("%s %d / %d (%s)"):format(part[2], sub.agree, sub.comparisons, change)
       end
     end
     if t.verdict == "untestable" and t.reason then numbers[#numbers + 1] = t.reason end
