@@ -591,7 +591,9 @@ local function overall_left()
     local names = {}
     for m in pairs(unknown) do names[#names + 1] = m end
     table.sort(names)
-    return ("at least %s left (no %s run finished yet)"):format(clock(total / jobs), table.concat(names, " or "))
+    local why = ("no %s run finished yet"):format(table.concat(names, " or "))
+    if total <= 0 then return ("time left not known yet (%s)"):format(why) end
+    return ("at least %s left (%s)"):format(clock(total / jobs), why)
   end
   return "about " .. clock(total / jobs) .. " left"
 end
