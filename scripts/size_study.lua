@@ -195,12 +195,17 @@ end
 if #series > 0 then
   local ok, err = pcall(figures.curves, {file = DIR .. "/size_study.png", xlabel = "joint side [cm]",
                                          ylabel = "shear stress [MPa]", series = series,
+                                         xrange = ("%g:%g"):format(sizes[1] * 100 * 0.8, math.max(largest, 0.1) * 100 * 1.05),
                                          title = ("%s, %g MPa, -%s"):format(P.surface, P.stress, P.direction)})
   if not ok then log("no plot: %s", tostring(err)) end
 end
 
 for _, m in ipairs(models) do
-  log("%s: smallest representative size %s", m, verdict[m] and ("%g cm"):format(verdict[m] * 100) or "none below the largest")
+  if not cells[m][largest] then
+    log("%s: no finished run at the largest size (%g cm): no verdict", m, largest * 100)
+  else
+    log("%s: smallest representative size %s", m, verdict[m] and ("%g cm"):format(verdict[m] * 100) or "none")
+  end
 end
 log("table: %s/size_study.csv; plot: %s/size_study.png", DIR, DIR)
 os.exit(math.min(unfinished, 100))
