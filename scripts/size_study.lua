@@ -57,23 +57,11 @@ table.sort(sizes)
 local largest = sizes[#sizes]
 local models = params_lib.split(P.models)
 
-local function shell_quote(s)
-  s = tostring(s)
-  if s:match("^[%w%%%+,%-%./:=@_]+$") then return s end
-  return "'" .. s:gsub("'", "'\\''") .. "'"
-end
-local function capture(cmd)
-  local p = assert(io.popen(cmd, "r"))
-  local text = p:read("a")
-  p:close()
-  return (text:gsub("%s+$", ""))
-end
-local cwd = capture("pwd")
-local function absolute(path) return path:sub(1, 1) == "/" and path or (cwd .. "/" .. path) end
-local DIR = absolute(P.out):gsub("/+$", "")
-local CACHE = P.cache ~= "" and absolute(P.cache) or DIR .. "/cache"
-local exe = P.asperity ~= "" and absolute(P.asperity) or capture("readlink -f /proc/$PPID/exe")
-local study_script = absolute(asperity.scripts_dir) .. "/study.lua"
+local sh = require("shell")
+local DIR = sh.absolute(P.out):gsub("/+$", "")
+local CACHE = P.cache ~= "" and sh.absolute(P.cache) or DIR .. "/cache"
+local exe = P.asperity ~= "" and sh.absolute(P.asperity) or sh.program()
+local study_script = sh.absolute(asperity.scripts_dir) .. "/study.lua"
 local function folder(size) return ("%s/size_%gcm"):format(DIR, size * 100) end
 
 asperity.mkdir(DIR)
@@ -85,20 +73,17 @@ for _, size in ipairs(sizes) do
                 "events_every=0", "report=false", "jobs=" .. P.jobs, "threads=" .. P.threads}
   if P.joint ~= "" then args[#args + 1] = "joint=" .. P.joint end
   if P.collect then args[#args + 1] = "collect=true" end
-  for k, a in ipairs(args) do args[k] = shell_quote(a) end
+  for k, a in ipairs(args) do args[k] = sh.quote(a) end
   log("%g cm: %s", size * 100, P.collect and "collecting" or "running (finished runs are kept)")
   local ok, _, status = os.execute(table.concat(args, " "))
   if not ok then unfinished = unfinished + (status or 1) end
 end
 
 -- The table: per size and model, mean and sample standard deviation over the seeds.
+local mean_sd = require("events").mean_sd
 local function stats(v)
-  local n, s = #v, 0
-  if n == 0 then return 0 / 0, 0 / 0, 0 end
-  for _, x in ipairs(v) do s = s + x end
-  local m, q = s / n, 0
-  for _, x in ipairs(v) do q = q + (x - m) ^ 2 end
-  return m, n > 1 and math.sqrt(q / (n - 1)) or 0 / 0, n
+  local m, sd = mean_sd(v)
+  return m, sd, #v
 end
 local cells = {}   -- cells[model][size] = {peak = {...}, residual = {...}, k0 = {...}, particles, seconds}
 for _, m in ipairs(models) do cells[m] = {} end
@@ -160,14 +145,8 @@ for _, r in ipairs(rows) do
   end
   lines[#lines + 1] = table.concat(f, ",")
 end
-local function write(path, text)
-  local f = assert(io.open(path .. ".tmp", "w"))
-  f:write(text)
-  f:close()
-  assert(os.rename(path .. ".tmp", path))
-end
-write(DIR .. "/size_study.csv", table.concat(lines, "\n") .. "\n")
-write(DIR .. "/size_study.json", asperity.json{rows = rows, tolerance = P.tolerance, reference_size_m = largest,
+sh.write_atomic(DIR .. "/size_study.csv", table.concat(lines, "\n") .. "\n")
+sh.write_atomic(DIR .. "/size_study.json", asperity.json{rows = rows, tolerance = P.tolerance, reference_size_m = largest,
                                                smallest_representative_m = verdict,
                                                default_size_m = default_size or false})
 

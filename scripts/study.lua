@@ -99,24 +99,12 @@ for k, v in ipairs(params_lib.split(P.seeds, true)) do seeds[k] = math.tointeger
 local extra = {}
 for item in P.joint:gmatch("%S+") do extra[#extra + 1] = item end
 
-local function shell_quote(s)
-  s = tostring(s)
-  if s:match("^[%w%%%+,%-%./:=@_]+$") then return s end
-  return "'" .. s:gsub("'", "'\\''") .. "'"
-end
-local function capture(cmd)
-  local p = assert(io.popen(cmd, "r"))
-  local text = p:read("a")
-  p:close()
-  return (text:gsub("%s+$", ""))
-end
--- Absolute paths: the commands must mean the same from any directory (a Slurm task's too).
-local cwd = capture("pwd")
-local function absolute(path) return path:sub(1, 1) == "/" and path or (cwd .. "/" .. path) end
+local sh = require("shell")
+local shell_quote, capture, absolute = sh.quote, sh.capture, sh.absolute
 local DIR = absolute(P.out):gsub("/+$", ""):gsub("/%./", "/")
 local CACHE = P.cache ~= "" and absolute(P.cache):gsub("/+$", "") or DIR .. "/cache"
--- The program: the one running this script ($PPID of a shell it starts), unless told.
-local exe = P.asperity ~= "" and absolute(P.asperity) or capture("readlink -f /proc/$PPID/exe")
+-- The program: the one running this script, unless told.
+local exe = P.asperity ~= "" and absolute(P.asperity) or sh.program()
 local joint_script = absolute(asperity.scripts_dir) .. "/joint.lua"
 
 -- The runs ---------------------------------------------------------------------------------------
@@ -182,27 +170,8 @@ local function command(run)
   return table.concat(args, " ")
 end
 
--- Files ------------------------------------------------------------------------------------------
-local function exists(path)
-  local f = io.open(path, "r")
-  if f then f:close() return true end
-  return false
-end
-local function read_text(path)
-  local f = io.open(path, "r")
-  if not f then return nil end
-  local t = f:read("a")
-  f:close()
-  return t
-end
--- Written to a temporary name and renamed, so no reader ever sees half a file.
-local function write_atomic(path, text)
-  local tmp = path .. ".tmp"
-  local f = assert(io.open(tmp, "w"))
-  f:write(text)
-  f:close()
-  assert(os.rename(tmp, path))
-end
+-- Files (written to a temporary name and renamed, so no reader ever sees half a file) -------------
+local exists, read_text, write_atomic = sh.exists, sh.read, sh.write_atomic
 
 -- The wrapper that runs one command and renames its folder (POSIX sh; flock from util-linux keeps
 -- two processes from running one run, e.g. a resumed runner and the last run of a killed one).

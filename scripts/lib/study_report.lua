@@ -37,12 +37,7 @@ local PAIRS = {
 local MODELS = {"rigid", "elastic", "fracture"}
 local COLOR = {rigid = "#d02020", elastic = "#2050d0", fracture = "#20a040"}
 
-local function write_atomic(path, text)
-  local f = assert(io.open(path .. ".tmp", "w"))
-  f:write(text)
-  f:close()
-  assert(os.rename(path .. ".tmp", path))
-end
+local write_atomic = require("shell").write_atomic
 local function finite(v) return type(v) == "number" and v == v and math.abs(v) < math.huge end
 local function mean_sd(v) return ev.mean_sd(v) end
 local function key(r, skip)

@@ -5,19 +5,11 @@ local json = require("json")
 local out = assert(params.out, "give out=DIRECTORY")
 os.execute("rm -rf '" .. out .. "'")
 asperity.mkdir(out)
-local exe = io.popen("readlink -f /proc/$PPID/exe"):read("l")
+local sh = require("shell")
+local exe = sh.program()
 local script = asperity.scripts_dir .. "/size_study.lua"
-local function read(path)
-  local f = io.open(path)
-  if not f then return nil end
-  local t = f:read("a")
-  f:close()
-  return t
-end
-local function run(args, log)
-  local ok, how, status = os.execute(("'%s' run '%s' %s > '%s' 2>&1"):format(exe, script, args, log))
-  return how == "exit" and status or -1, read(log) or ""
-end
+local read = sh.read
+local function run(args, log) return sh.run(("%s run %s %s"):format(sh.quote(exe), sh.quote(script), args), log) end
 
 local dir = out .. "/size"
 local args = ("sizes=0.01,0.008 models=rigid jobs=2 threads=1 tolerance=0.2 out='%s' " ..

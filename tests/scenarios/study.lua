@@ -10,20 +10,12 @@ local json = require("json")
 local out = assert(params.out, "give out=DIRECTORY")
 os.execute("rm -rf '" .. out .. "'")
 asperity.mkdir(out)
-local exe = io.popen("readlink -f /proc/$PPID/exe"):read("l")
+local sh = require("shell")
+local exe = sh.program()
 local study = asperity.scripts_dir .. "/study.lua"
-local function read(path)
-  local f = io.open(path)
-  if not f then return nil end
-  local t = f:read("a")
-  f:close()
-  return t
-end
-local function exists(path) return read(path) ~= nil end
-local function run(args, log)
-  local ok, how, status = os.execute(("'%s' run '%s' %s > '%s' 2>&1"):format(exe, study, args, log))
-  return how == "exit" and status or -1, read(log) or ""
-end
+local read = sh.read
+local exists = sh.exists
+local function run(args, log) return sh.run(("%s run %s %s"):format(sh.quote(exe), sh.quote(study), args), log) end
 
 -- 1. The reduced study.
 local dir = out .. "/study"

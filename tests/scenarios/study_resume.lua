@@ -7,25 +7,15 @@ local out = assert(params.out, "give out=DIRECTORY")
 local dir = out .. "/study"
 os.execute("rm -rf '" .. out .. "'")
 asperity.mkdir(out)
-local exe = io.popen("readlink -f /proc/$PPID/exe"):read("l")
+local sh = require("shell")
+local exe = sh.program()
 local study = asperity.scripts_dir .. "/study.lua"
 local cmd = ("'%s' run '%s' surfaces=S1 stresses=14 directions=x,y models=rigid,elastic jobs=1 threads=1 " ..
              "report=false size=0.008 out='%s' joint='thickness=0.003 shear=1 pack_steps=50000 velocity=5e-6'")
             :format(exe, study, dir)
 local names = {"S1_14_x_rigid_s1", "S1_14_x_elastic_s1", "S1_14_y_rigid_s1", "S1_14_y_elastic_s1"}
 
-local function exists(path)
-  local f = io.open(path)
-  if f then f:close() end
-  return f ~= nil
-end
-local function read(path)
-  local f = io.open(path)
-  if not f then return nil end
-  local t = f:read("a")
-  f:close()
-  return t
-end
+local exists, read = sh.exists, sh.read
 local function sleep(s) io.popen(("sleep %g"):format(s)):close() end
 -- Every folder named as a result holds a summary that parses (the runner renames only complete ones).
 local function check_results()
