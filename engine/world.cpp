@@ -60,14 +60,34 @@ void require_density(double rho, const std::string& what) {
               "] kg/m^3");
 }
 
-void check_material(const ContactMaterial& m, const char* where) {
-  require(m.kn >= kMinStiffness && m.kn <= kMaxStiffness,
-          std::string(where) + ": kn " + num(m.kn) + " outside [" + num(kMinStiffness) + ", " +
-              num(kMaxStiffness) + "] N/m");
-  require(m.ks >= 0 && m.ks <= kMaxStiffness,
-          std::string(where) + ": ks " + num(m.ks) + " outside [0, " + num(kMaxStiffness) + "] N/m");
-  require(m.friction >= 0 && std::isfinite(m.friction),
-          std::string(where) + ": friction must be >= 0, got " + num(m.friction));
+// A value against its field (fields.hpp): `where` names the call, e.g. "set_dt_safety: ".
+void check_value(const std::string& where, const Field& f, double v) {
+  const std::string problem = range_problem(f.name, v, f.range);
+  require(problem.empty(), where + problem);
+}
+void check_value(const std::string& where, const Field& f, int v) { check_value(where, f, double(v)); }
+void check_value(const std::string&, const Field&, bool) {}
+void check_value(const std::string&, const Field&, const std::string&) {}  // simd: by the kernel registry
+void check_value(const std::string& where, const Field& f, const Vec3& v) {
+  require_finite(v, (where + f.name).c_str());
+}
+void check_material(const ContactMaterial& m, const std::string& where) {
+  for_each_field(m, [&](const Field& f, double v) { check_value(where + ": ", f, v); });
+}
+void check_value(const std::string& where, const Field& f, const ContactMaterial& m) {
+  check_material(m, where + f.name);
+}
+// The field of WorldSettings called `name`.
+Field setting_field(const char* name) {
+  WorldSettings defaults;
+  Field found{nullptr};
+  for_each_setting(defaults, [&](const Field& f, const auto&) {
+    if (std::string_view(f.name) == name) found = f;
+  });
+  return found;
+}
+void check_setting(const char* where, const char* name, double v) {
+  check_value(std::string(where) + ": ", setting_field(name), v);
 }
 
 void set_mass(detail::ParticleStore& p, std::size_t i) {
@@ -124,26 +144,7 @@ double Energies::balance_error(const Energies& initial) const {
 
 World::World(WorldSettings settings) : state_(std::make_unique<State>()) {
   State& s = *state_;
-  check_material(settings.contact, "contact material");
-  require_density(settings.density, "density");
-  require(settings.local_damping >= 0 && settings.local_damping < 1,
-          "local_damping must be in [0, 1), got " + num(settings.local_damping));
-  require(settings.skin >= 0 && settings.skin <= kMaxCoordinate,
-          "skin must be >= 0 (0: automatic) and finite, got " + num(settings.skin));
-  require(settings.dt == 0 || (settings.dt >= kMinDt && std::isfinite(settings.dt)),
-          "dt " + num(settings.dt) + " must be 0 (automatic) or in [" + num(kMinDt) + ", inf) s");
-  require(settings.dt_safety >= kMinDtSafety && settings.dt_safety <= 1,
-          "dt_safety " + num(settings.dt_safety) + " outside [" + num(kMinDtSafety) + ", 1]");
-  require(settings.dt_interval >= 1, "dt_interval must be >= 1");
-  require(settings.threads >= 0 && settings.threads <= kMaxThreads,
-          "threads " + std::to_string(settings.threads) + " outside 0.." + std::to_string(kMaxThreads) +
-              " (0: automatic)");
-  require(settings.reorder_interval >= 0, "reorder_interval must be >= 0");
-  require(settings.overlap_limit > 0 && settings.overlap_limit < 2,
-          "overlap_limit must be in (0, 2) radii of the smaller body, got " + num(settings.overlap_limit));
-  require(settings.rotation_lock_bonds >= 1,
-          "rotation_lock_bonds must be >= 1, got " + std::to_string(settings.rotation_lock_bonds));
-  require_finite(settings.gravity, "gravity");
+  for_each_setting(settings, [](const Field& f, const auto& v) { check_value("", f, v); });
   s.kernels = &kernels::select_kernels(settings.simd);
   s.max_threads = omp_get_max_threads();
   s.settings = settings;
@@ -866,16 +867,14 @@ std::uint64_t World::cycle(std::uint64_t n) {
 void World::request_stop() { state_->stop_requested.store(true); }
 double World::dt() const { return state_->dt; }
 void World::set_dt(double dt) {
-  require(dt == 0 || (dt >= kMinDt && std::isfinite(dt)),
-          "set_dt: dt " + num(dt) + " must be 0 (automatic) or in [" + num(kMinDt) + ", inf) s");
+  check_setting("set_dt", "dt", dt);
   state_->dt_fixed = dt > 0;
   state_->dt = dt;
   state_->last_estimate_step = 0;
   state_->need_rebuild = true;  // forces a fresh estimate (and its check) before the next step
 }
 void World::set_dt_safety(double f) {
-  require(f >= kMinDtSafety && f <= 2,
-          "set_dt_safety: factor " + num(f) + " outside [" + num(kMinDtSafety) + ", 2]");
+  check_setting("set_dt_safety", "dt_safety", f);
   state_->settings.dt_safety = f;
   state_->last_estimate_step = 0;
   state_->need_rebuild = true;  // a fresh estimate before the next step
@@ -888,12 +887,13 @@ void World::set_friction(double mu) {
   state_->settings.contact = m;
 }
 void World::set_overlap_limit(double r) {
-  require(r > 0 && r < 2, "set_overlap_limit: " + num(r) + " outside (0, 2) radii of the smaller body");
+  check_setting("set_overlap_limit", "overlap_limit", r);
   state_->settings.overlap_limit = r;
 }
 void World::set_skin(double skin) {
-  require(skin > 0 && skin <= kMaxCoordinate,
-          "set_skin: skin " + num(skin) + " outside (0, " + num(kMaxCoordinate) + "] m");
+  // 0 (automatic) is the first build's choice: a running world keeps a skin.
+  require(skin != 0, "set_skin: skin must be > 0 (0, automatic, is only for a new world)");
+  check_setting("set_skin", "skin", skin);
   state_->settings.skin = skin;
   state_->skin = skin;
   state_->need_rebuild = true;
@@ -906,9 +906,7 @@ double World::critical_dt() {
 std::uint64_t World::step_count() const { return state_->step; }
 double World::time() const { return state_->time; }
 void World::set_threads(int threads) {
-  require(threads >= 0 && threads <= kMaxThreads,
-          "set_threads: threads " + std::to_string(threads) + " outside 0.." + std::to_string(kMaxThreads) +
-              " (0: automatic)");
+  check_setting("set_threads", "threads", threads);
   state_->settings.threads = threads;
 }
 std::string World::simd_architecture() const { return state_->kernels->name; }

@@ -134,31 +134,23 @@ struct Reader {
   }
 };
 
-void visit_material(auto& io, const std::string& at, ContactMaterial& m) {
-  io.scalar(at + "/kn", m.kn);
-  io.scalar(at + "/ks", m.ks);
-  io.scalar(at + "/friction", m.friction);
+// A field's value saved under `at`, by its type.
+void visit_value(auto& io, const std::string& at, double& v) { io.scalar(at, v); }
+void visit_value(auto& io, const std::string& at, int& v) { io.scalar(at, v); }
+void visit_value(auto& io, const std::string& at, bool& v) { io.flag(at, v); }
+void visit_value(auto& io, const std::string& at, Vec3& v) { io.vec(at, v); }
+void visit_value(auto&, const std::string&, std::string&) {}  // no text setting is saved
+void visit_value(auto& io, const std::string& at, ContactMaterial& m) {
+  for_each_field(m, [&](const Field& f, double& v) { io.scalar(at + "/" + f.stored, v); });
 }
 
 template <class Io>
 void visit(Io& io, State& s) {
-  // Settings (threads and SIMD are the loader's choice: results do not depend on them).
-  WorldSettings& ws = s.settings;
-  visit_material(io, "settings/contact", ws.contact);
-  io.scalar("settings/density", ws.density);
-  io.scalar("settings/local_damping", ws.local_damping);
-  io.vec("settings/gravity", ws.gravity);
-  io.flag("settings/rotation", ws.rotation);
-  io.scalar("settings/skin", ws.skin);
-  io.scalar("settings/dt", ws.dt);
-  io.scalar("settings/dt_safety", ws.dt_safety);
-  io.flag("settings/allow_dt_above_estimate", ws.allow_dt_above_estimate);
-  io.scalar("settings/dt_interval", ws.dt_interval);
-  io.flag("settings/track_energy", ws.track_energy);
-  io.scalar("settings/reorder_interval", ws.reorder_interval);
-  io.flag("settings/lock_bonded_rotation", ws.lock_bonded_rotation);
-  if (io.version >= 6) io.scalar("settings/rotation_lock_bonds", ws.rotation_lock_bonds);
-  if (io.version >= 8) io.scalar("settings/overlap_limit", ws.overlap_limit);
+  // Settings: every stored field of the table (world.hpp), those added after the file's version
+  // keep their defaults.
+  for_each_setting(s.settings, [&](const Field& f, auto& v) {
+    if (f.stored != nullptr && io.version >= f.since) visit_value(io, std::string("settings/") + f.stored, v);
+  });
 
   // Clock, time step, neighbour bookkeeping, ledgers.
   io.scalar("run/step", s.step);
@@ -306,7 +298,7 @@ void visit(Io& io, State& s) {
     std::uint8_t kind = static_cast<std::uint8_t>(wall.kind);
     io.scalar(at + "/kind", kind);
     wall.kind = static_cast<detail::Wall::Kind>(kind);
-    visit_material(io, at + "/material", wall.material);
+    visit_value(io, at + "/material", wall.material);
     io.vec(at + "/point", wall.point);
     io.vec(at + "/normal", wall.normal);
     io.scalar(at + "/mesh", wall.mesh);
@@ -390,6 +382,20 @@ void visit(Io& io, State& s) {
   }
 }
 
+// Whether a stored setting holds a value its field accepts (world.hpp, for_each_setting).
+bool setting_valid(const Field& f, double v) { return f.range.contains(v); }
+bool setting_valid(const Field& f, int v) { return f.range.contains(v); }
+bool setting_valid(const Field&, bool) { return true; }
+bool setting_valid(const Field&, const std::string&) { return true; }
+bool setting_valid(const Field&, const Vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+bool setting_valid(const Field&, const ContactMaterial& m) {
+  bool ok = true;
+  for_each_field(m, [&](const Field& f, double v) { ok = ok && f.range.contains(v); });
+  return ok;
+}
+
 // Everything a step or a reader relies on, checked after loading: sizes of the columns, indices
 // in range, finite values. A file that passes the checksum was written by save(); these checks
 // also cover older files without one, and a file whose checksum was forged.
@@ -399,19 +405,9 @@ void validate(const State& s, const std::string& path) {
   };
   auto finite = [](double v) { return std::isfinite(v); };
   auto finite3 = [](const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
-  const WorldSettings& ws = s.settings;
-  for (const ContactMaterial* m : {&ws.contact}) {
-    need(m->kn > 0 && finite(m->kn) && m->ks >= 0 && finite(m->ks) && m->friction >= 0 && finite(m->friction),
-         "settings/contact");
-  }
-  need(ws.density > 0 && finite(ws.density), "settings/density");
-  need(ws.local_damping >= 0 && ws.local_damping < 1, "settings/local_damping");
-  need(finite3(ws.gravity), "settings/gravity");
-  need(ws.skin >= 0 && finite(ws.skin), "settings/skin");
-  need(ws.dt >= 0 && finite(ws.dt), "settings/dt");
-  need(ws.dt_safety > 0 && ws.dt_safety <= 2, "settings/dt_safety");
-  need(ws.dt_interval >= 1, "settings/dt_interval");
-  need(ws.reorder_interval >= 0, "settings/reorder_interval");
+  for_each_setting(s.settings, [&](const Field& f, const auto& v) {
+    if (f.stored != nullptr) need(setting_valid(f, v), std::string("settings/") + f.stored);
+  });
   need(finite(s.time) && s.dt >= 0 && finite(s.dt) && !std::isnan(s.dt_estimate) && s.skin >= 0 && finite(s.skin),
        "run/time, run/dt or run/skin");
   need(finite(s.reference_energy) && finite(s.reference_input) && finite(s.kinetic_at_step), "run energies");

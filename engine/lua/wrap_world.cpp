@@ -43,9 +43,7 @@ int group_arg(lua_State* L, int arg, const World& w) {
 ContactMaterial material_field(lua_State* L, Options& o, const char* key, ContactMaterial base) {
   if (o.push_checked(key, LUA_TTABLE, "a table {kn=, ks=, friction=}") == LUA_TTABLE) {
     Options m(L, -1, o.context() + " option '" + key + "'", 0);
-    base.kn = m.number("kn", base.kn);
-    base.ks = m.number("ks", base.ks);
-    base.friction = m.number("friction", base.friction);
+    for_each_field(base, [&](const Field& f, double& v) { v = m.number(f.name, v); });
     m.finish();
   }
   lua_pop(L, 1);
@@ -54,12 +52,69 @@ ContactMaterial material_field(lua_State* L, Options& o, const char* key, Contac
 
 void push_material(lua_State* L, const ContactMaterial& m) {
   lua_createtable(L, 0, 3);
-  lua_pushnumber(L, m.kn);
-  lua_setfield(L, -2, "kn");
-  lua_pushnumber(L, m.ks);
-  lua_setfield(L, -2, "ks");
-  lua_pushnumber(L, m.friction);
-  lua_setfield(L, -2, "friction");
+  for_each_field(m, [&](const Field& f, double v) {
+    lua_pushnumber(L, v);
+    lua_setfield(L, -2, f.name);
+  });
+}
+
+// Option f.name of a settings table into v, by type; an absent option keeps v. The World checks
+// the values; an integer is checked here, before it is narrowed.
+void read_option(lua_State*, Options& o, const Field& f, double& v) { v = o.number(f.name, v); }
+void read_option(lua_State*, Options& o, const Field& f, int& v) {
+  const lua_Integer i = o.integer(f.name, v);
+  const std::string problem = range_problem(f.name, double(i), f.range);
+  if (!problem.empty()) throw Error(o.context() + ": " + problem);
+  v = static_cast<int>(i);
+}
+void read_option(lua_State*, Options& o, const Field& f, bool& v) { v = o.boolean(f.name, v); }
+void read_option(lua_State*, Options& o, const Field& f, std::string& v) { v = o.string(f.name, v); }
+void read_option(lua_State*, Options& o, const Field& f, Vec3& v) {
+  if (auto g = o.vec(f.name)) v = *g;
+}
+void read_option(lua_State* L, Options& o, const Field& f, ContactMaterial& v) {
+  v = material_field(L, o, f.name, v);
+}
+
+void push_value(lua_State* L, double v) { lua_pushnumber(L, v); }
+void push_value(lua_State* L, int v) { lua_pushinteger(L, v); }
+void push_value(lua_State* L, bool v) { lua_pushboolean(L, v); }
+void push_value(lua_State* L, const std::string& v) { lua_pushstring(L, v.c_str()); }
+void push_value(lua_State* L, const Vec3& v) { push_vec(L, v); }
+void push_value(lua_State* L, const ContactMaterial& v) { push_material(L, v); }
+
+// A default as help() shows it: 2500, true, "auto", {0, 0, 0}, {kn = 0.1, ...}.
+std::string default_text(double v) { return short_number_text(v); }
+std::string default_text(int v) { return std::to_string(v); }
+std::string default_text(bool v) { return v ? "true" : "false"; }
+std::string default_text(const std::string& v) { return "\"" + v + "\""; }
+std::string default_text(const Vec3& v) {
+  return "{" + short_number_text(v.x) + ", " + short_number_text(v.y) + ", " + short_number_text(v.z) + "}";
+}
+std::string default_text(const ContactMaterial& m) {
+  std::string t;
+  for_each_field(m, [&](const Field& f, double v) {
+    t += (t.empty() ? "{" : ", ") + std::string(f.name) + " = " + short_number_text(v);
+  });
+  return t + "}";
+}
+
+// asperity.world's help: every setting with its default, accepted values and meaning.
+const char* world_settings_help() {
+  static const std::string text = [] {
+    std::string t = "A new world. Options (default: meaning):";
+    WorldSettings defaults;
+    for_each_setting(defaults, [&](const Field& f, const auto& v) {
+      using T = std::decay_t<decltype(v)>;
+      t += std::string("\n  ") + f.name + " = " + default_text(v);
+      if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>)
+        t += (f.range.zero != nullptr ? std::string(" (0: ") + f.range.zero + ") or in " : std::string(" in ")) +
+             range_text(f.range);
+      t += std::string(": ") + f.doc;
+    });
+    return t;
+  }();
+  return text.c_str();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -69,23 +124,7 @@ int world_new(lua_State* L) {
   return guarded(L, [&] {
     WorldSettings s;
     Options o(L, 1, "asperity.world", 1);
-    s.contact = material_field(L, o, "material", s.contact);
-    s.density = o.number("density", s.density);
-    s.local_damping = o.number("damping", s.local_damping);
-    if (auto g = o.vec("gravity")) s.gravity = *g;
-    s.rotation = o.boolean("rotation", s.rotation);
-    s.skin = o.number("skin", s.skin);
-    s.dt = o.number("dt", s.dt);
-    s.dt_safety = o.number("dt_safety", s.dt_safety);
-    s.allow_dt_above_estimate = o.boolean("allow_dt_above_estimate", s.allow_dt_above_estimate);
-    s.dt_interval = int_in(o.integer("dt_interval", s.dt_interval), "asperity.world: dt_interval", 1, 1 << 30);
-    s.threads = int_in(o.integer("threads", s.threads), "asperity.world: threads", 0, kMaxThreads);
-    s.simd = o.string("simd", s.simd);
-    s.track_energy = o.boolean("track_energy", s.track_energy);
-    s.reorder_interval = int_in(o.integer("reorder_interval", s.reorder_interval), "asperity.world: reorder_interval", 0, 1 << 30);
-    s.lock_bonded_rotation = o.boolean("lock_bonded_rotation", s.lock_bonded_rotation);
-    s.rotation_lock_bonds = static_cast<int>(o.integer("rotation_lock_bonds", s.rotation_lock_bonds));
-    s.overlap_limit = o.number("overlap_limit", s.overlap_limit);
+    for_each_setting(s, [&](const Field& f, auto& v) { read_option(L, o, f, v); });
     o.finish();
     // Construct before setting the metatable: if the constructor throws, no __gc will ever run
     // on the uninitialised block.
@@ -123,30 +162,11 @@ int world_tostring(lua_State* L) {
 int world_settings(lua_State* L) {
   return guarded(L, [&] {
     const WorldSettings& s = world_arg(L).settings();
-    lua_createtable(L, 0, 15);
-    push_material(L, s.contact);
-    lua_setfield(L, -2, "material");
-    auto num = [&](const char* k, double v) { lua_pushnumber(L, v); lua_setfield(L, -2, k); };
-    auto integer = [&](const char* k, lua_Integer v) { lua_pushinteger(L, v); lua_setfield(L, -2, k); };
-    auto boolean = [&](const char* k, bool v) { lua_pushboolean(L, v); lua_setfield(L, -2, k); };
-    num("density", s.density);
-    num("damping", s.local_damping);
-    push_vec(L, s.gravity);
-    lua_setfield(L, -2, "gravity");
-    boolean("rotation", s.rotation);
-    num("skin", s.skin);
-    num("dt", s.dt);
-    num("dt_safety", s.dt_safety);
-    boolean("allow_dt_above_estimate", s.allow_dt_above_estimate);
-    integer("dt_interval", s.dt_interval);
-    integer("threads", s.threads);
-    lua_pushstring(L, s.simd.c_str());
-    lua_setfield(L, -2, "simd");
-    boolean("track_energy", s.track_energy);
-    integer("reorder_interval", s.reorder_interval);
-    boolean("lock_bonded_rotation", s.lock_bonded_rotation);
-    integer("rotation_lock_bonds", s.rotation_lock_bonds);
-    num("overlap_limit", s.overlap_limit);
+    lua_newtable(L);
+    for_each_setting(s, [&](const Field& f, const auto& v) {
+      push_value(L, v);
+      lua_setfield(L, -2, f.name);
+    });
     return 1;
   });
 }
@@ -1377,15 +1397,7 @@ void open_world(lua_State* L) {
       {"world", world_new,
        "asperity.world{[material=] [, density=] [, damping=] [, gravity=] [, rotation=] [, dt=] ...}\n"
        "  -> World",
-       "A new world. Options (defaults): material = {kn = 0.1, ks = 0.01, friction = 0.5},\n"
-       "density = 2500, damping = 0.7 (local), gravity = {0, 0, 0}, rotation = true, skin = 0\n"
-       "(auto), dt = 0 (auto), dt_safety = 0.8, allow_dt_above_estimate = false,\n"
-       "dt_interval = 100, threads = 0 (automatic), simd = \"auto\" (scalar, sse4_2, avx2, avx512f;\n"
-       "float: the force laws in single precision, scalar, for the run-time study),\n"
-       "track_energy = true, reorder_interval = 10, lock_bonded_rotation = true,\n"
-       "rotation_lock_bonds = 1 (a bonded particle none of whose bonds broke is locked; a damaged one\n"
-       "while it still has at least this many intact bonds), overlap_limit = 1 (the health check stops\n"
-       "a run when a contact or bond overlaps deeper than this many radii of its smaller body; < 2)."},
+       world_settings_help()},
       {"load", l_load, "asperity.load(path [, {threads=, simd=}]) -> World",
        "A world from a checkpoint written by world:save(path)."},
       {"bond_criterion", l_bond_criterion, "asperity.bond_criterion(sigma, tau, tensile_strength) -> f",

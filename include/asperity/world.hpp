@@ -10,12 +10,15 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "asperity/error.hpp"
+#include "asperity/fields.hpp"
 #include "asperity/vec3.hpp"
 
 namespace asperity {
@@ -55,29 +58,98 @@ struct BondMaterial {
   bool breakable = true;           // false: the elastic model (bonds never break)
 };
 
+// What a World is made with. Each field is described (Lua name, checkpoint name, accepted values,
+// meaning) once, in for_each_setting below.
 struct WorldSettings {
-  ContactMaterial contact;          // ball-ball contacts
-  double density = 2500.0;          // kg/m^3, default for add_particle
-  double local_damping = 0.7;       // Cundall alpha, [3-28]
-  Vec3 gravity{0, 0, 0};            // m/s^2
-  bool rotation = true;             // false: no particle rotates (and none pays for rotation)
-  double skin = 0.0;                // Verlet skin, m; 0: 0.4 * mean radius at the first build
-  double dt = 0.0;                  // s; 0: automatic, dt_safety * critical estimate [3-30..3-32]
+  ContactMaterial contact;
+  double density = 2500.0;
+  double local_damping = 0.7;
+  Vec3 gravity{0, 0, 0};
+  bool rotation = true;
+  double skin = 0.0;
+  double dt = 0.0;
   double dt_safety = 0.8;
-  bool allow_dt_above_estimate = false;  // a fixed dt above the estimate is an error unless set
-  int dt_interval = 100;            // steps between critical-step estimates (also at each rebuild)
-  int threads = 0;                  // OpenMP threads; 0: automatic (1 per 10 000 pairs or 5 000
-                                    // bonds, or per 20 000 particles, up to the cores available
-                                    // and not kept busy by other processes, sampled every 0.5 s)
-  std::string simd = "auto";        // "auto", "scalar", "sse4_2", "avx2", "avx512f"
-  bool track_energy = true;         // friction, damping and boundary work ledgers (model.md 8)
-  int reorder_interval = 10;        // neighbour rebuilds between reorders by cell; 0: never
-  bool lock_bonded_rotation = true; // a particle holding an intact bond does not rotate (model.md 2)
-  int rotation_lock_bonds = 1;      // ... holding at least this many intact bonds: the restriction
-                                    // ends once a particle has lost all but fewer of its bonds
-  double overlap_limit = 1.0;       // health: the deepest overlap allowed, in radii of the smaller
-                                    // body (< 2); a rigid block's contacts may pass this deep
+  bool allow_dt_above_estimate = false;
+  int dt_interval = 100;
+  int threads = 0;
+  std::string simd = "auto";
+  bool track_energy = true;
+  int reorder_interval = 10;
+  bool lock_bonded_rotation = true;
+  int rotation_lock_bonds = 1;
+  double overlap_limit = 1.0;
 };
+
+// visit(field, member) for each field of WorldSettings, in checkpoint order. The World checks
+// every value against its field, the Lua binding reads and pushes them by name, a checkpoint
+// saves the stored ones (threads and simd are the loader's choice: results do not depend on
+// them) and help() lists them with their defaults.
+template <class Settings, class Visit>
+void for_each_setting(Settings& s, Visit&& visit) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  visit(Field{"material", "contact", 1, {}, "ball-ball contacts {kn = N/m, ks = N/m, friction} (model.md 4)"},
+        s.contact);
+  visit(Field{"density", "density", 1, {kMinDensity, kMaxDensity, false, false, nullptr, "kg/m^3"},
+              "default density of add_particle, kg/m^3"},
+        s.density);
+  visit(Field{"damping", "local_damping", 1, {0, 1, false, true}, "local (Cundall) damping alpha [3-28]"},
+        s.local_damping);
+  visit(Field{"gravity", "gravity", 1, {}, "acceleration of gravity, m/s^2"}, s.gravity);
+  visit(Field{"rotation", "rotation", 1, {}, "false: no particle rotates (and none pays for rotation)"},
+        s.rotation);
+  visit(Field{"skin", "skin", 1, {0, kMaxCoordinate, true, false, "automatic", "m"},
+              "Verlet skin; automatic: 0.4 x the mean radius at the first build"},
+        s.skin);
+  visit(Field{"dt", "dt", 1, {kMinDt, inf, false, true, "automatic", "s"},
+              "time step; automatic: dt_safety x the critical estimate [3-30..3-32]"},
+        s.dt);
+  visit(Field{"dt_safety", "dt_safety", 1, {kMinDtSafety, 2}, "automatic dt / critical estimate"},
+        s.dt_safety);
+  visit(Field{"allow_dt_above_estimate", "allow_dt_above_estimate", 1, {},
+              "a fixed dt above the critical estimate is an error unless set"},
+        s.allow_dt_above_estimate);
+  visit(Field{"dt_interval", "dt_interval", 1, {1, 1e9},
+              "steps between critical-step estimates (also at each neighbour build)"},
+        s.dt_interval);
+  visit(Field{"threads", nullptr, 1, {1, kMaxThreads, false, false, "automatic"},
+              "OpenMP threads; automatic: from the pairs and bonds, up to the cores that other "
+              "processes leave free"},
+        s.threads);
+  visit(Field{"simd", nullptr, 1, {},
+              "\"auto\", \"scalar\", \"sse4_2\", \"avx2\", \"avx512f\" (those this CPU runs)"},
+        s.simd);
+  visit(Field{"track_energy", "track_energy", 1, {},
+              "friction, damping and boundary work ledgers (model.md 8)"},
+        s.track_energy);
+  visit(Field{"reorder_interval", "reorder_interval", 1, {0, 1e9},
+              "neighbour builds between reorders by cell; 0: never"},
+        s.reorder_interval);
+  visit(Field{"lock_bonded_rotation", "lock_bonded_rotation", 1, {},
+              "a particle holding an intact bond does not rotate (model.md 2)"},
+        s.lock_bonded_rotation);
+  visit(Field{"rotation_lock_bonds", "rotation_lock_bonds", 6, {1, 1e9},
+              "a bonded particle none of whose bonds broke is locked; a damaged one while it still "
+              "holds at least this many intact bonds"},
+        s.rotation_lock_bonds);
+  visit(Field{"overlap_limit", "overlap_limit", 8, {0, 2, true, true},
+              "health: the deepest contact or bond overlap allowed, in radii of its smaller body "
+              "(a rigid block's contacts may pass deeper than 1)"},
+        s.overlap_limit);
+}
+
+// visit(field, member) for each field of a contact material.
+template <class Material, class Visit>
+void for_each_field(Material& m, Visit&& visit)
+  requires std::is_same_v<std::remove_const_t<Material>, ContactMaterial>
+{
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  visit(Field{"kn", "kn", 1, {kMinStiffness, kMaxStiffness, false, false, nullptr, "N/m"},
+              "normal stiffness, N/m"},
+        m.kn);
+  visit(Field{"ks", "ks", 1, {0, kMaxStiffness, false, false, nullptr, "N/m"}, "shear stiffness, N/m"},
+        m.ks);
+  visit(Field{"friction", "friction", 1, {0, inf, false, true}, "Coulomb coefficient mu"}, m.friction);
+}
 
 // How a rigid group's degree of freedom moves (model.md 1, 7).
 enum class Dof : std::uint8_t { free, fixed, velocity, servo };

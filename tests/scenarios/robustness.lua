@@ -60,7 +60,7 @@ w:cycle(10)
 assert(world_is_finite(w))
 
 -- A time-step safety factor that makes dt = 0.
-refuses("set_dt_safety: factor 9%.99989e%-321 outside %[0%.001, 2%]", w.set_dt_safety, w, 1e-320)
+refuses("set_dt_safety: dt_safety 9%.99989e%-321 outside %[0%.001, 2%]", w.set_dt_safety, w, 1e-320)
 refuses("set_dt: dt 9%.99989e%-321 must be 0", w.set_dt, w, 1e-320)
 local t0 = w:time()
 w:cycle(10)
