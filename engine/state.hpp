@@ -126,11 +126,6 @@ struct State {
   PairStore inherited;
   std::vector<BreakEvent> break_events;
   std::vector<double> bond_block_breaks;
-  std::vector<std::uint8_t> user_rotation_locked;  // set by the API; bonds add their own lock
-  // Per particle, how many of its bonds have broken: a particle keeps its rotation lock while it
-  // holds min(rotation_lock_bonds, installed) bonds, installed = intact + broken
-  // (refresh_bond_topology).
-  std::vector<std::int32_t> bonds_broken;
   bool any_rotating = true;  // some particle can rotate: kernels read angular velocities
   // Whether a particle spins (an angular velocity other than +0) as the last step left them: the
   // bits of wx, wy, wz ORed over the particles a pair can reach (not inert), and over the ones

@@ -228,8 +228,6 @@ std::int64_t World::add_particles(std::span<const double> xyz, std::span<const d
     p.id[i] = first_id + std::int64_t(k);
     p.index_of_id.push_back(std::int64_t(i));
   }
-  s.user_rotation_locked.resize(p.n, 0);
-  s.bonds_broken.resize(p.n, 0);
   s.partner_start.resize(p.n + 1, s.partner_start.empty() ? 0 : s.partner_start.back());
   s.any_rotating = s.any_rotating || s.settings.rotation;
   // Bond and pair padding point at null particles, whose indices moved with the new count.
@@ -351,7 +349,7 @@ void World::set_rotation_locked(std::int64_t id, bool locked) {
   const auto i = index_of(*state_, id);
   require(state_->settings.rotation || locked,
           "rotation is disabled in this world (settings.rotation = false)");
-  state_->user_rotation_locked[i] = locked ? 1 : 0;
+  state_->p.user_rotation_locked[i] = locked ? 1 : 0;
   detail::refresh_bond_topology(*state_);
 }
 
@@ -774,7 +772,7 @@ void World::remove_bonds() {
   State& s = *state_;
   s.bonds.resize(0);
   s.frozen_bonds.resize(0);
-  s.bonds_broken.assign(s.p.n, 0);  // no bond left, none counts as broken
+  s.p.bonds_broken.assign(s.p.n, 0);  // no bond left, none counts as broken
   detail::refresh_bond_topology(s);
   touch(s);  // the freed pairs enter the contact list at the next rebuild
   s.reference_energy = -1;

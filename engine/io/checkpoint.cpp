@@ -134,6 +134,13 @@ struct Reader {
   }
 };
 
+// A store's column under `at` + its name; a file older than the column gives it `size` pads.
+template <class Io, class V>
+void visit_column(Io& io, const std::string& at, const detail::ColumnInfo& c, V& col, std::size_t size) {
+  if (io.version >= c.since) io.column(at + c.name, col);
+  else col.assign(size, static_cast<typename V::value_type>(c.pad));
+}
+
 // A field's value saved under `at`, by its type.
 void visit_value(auto& io, const std::string& at, double& v) { io.scalar(at, v); }
 void visit_value(auto& io, const std::string& at, int& v) { io.scalar(at, v); }
@@ -179,27 +186,12 @@ void visit(Io& io, State& s) {
   auto& p = s.p;
   io.scalar("particles/n", p.n);
   io.flag("particles/has_applied", p.has_applied);
-  for (auto [name, col] : {std::pair{"x", &p.x}, {"y", &p.y}, {"z", &p.z}, {"vx", &p.vx},
-                           {"vy", &p.vy}, {"vz", &p.vz}, {"wx", &p.wx}, {"wy", &p.wy},
-                           {"wz", &p.wz}, {"radius", &p.radius}, {"mass", &p.mass},
-                           {"inv_mass", &p.inv_mass}, {"inertia", &p.inertia},
-                           {"inv_inertia", &p.inv_inertia}, {"fx", &p.fx}, {"fy", &p.fy},
-                           {"fz", &p.fz}, {"tx", &p.tx}, {"ty", &p.ty}, {"tz", &p.tz},
-                           {"x0", &p.x0}, {"y0", &p.y0}, {"z0", &p.z0}, {"ax", &p.ax},
-                           {"ay", &p.ay}, {"az", &p.az}})
-    io.column(std::string("particles/") + name, *col);
-  io.column("particles/density", p.density);
-  io.column("particles/rotation_locked", p.rotation_locked);
-  io.column("particles/group", p.group);
-  io.column("particles/tag", p.tag);
-  io.column("particles/flags", p.flags);
-  io.column("particles/inert", p.inert);
-  io.column("particles/id", p.id);
-  io.column("particles/index_of_id", p.index_of_id);
-  io.column("particles/user_rotation_locked", s.user_rotation_locked);
+  detail::ParticleStore::slot_columns(
+      [&](const detail::ColumnInfo& c, auto& col) { visit_column(io, "particles/", c, col, p.capacity); }, p);
   // Older files: no break counted (a damaged particle of theirs is locked again while bonded).
-  if (io.version >= 7) io.column("particles/bonds_broken", s.bonds_broken);
-  else s.bonds_broken.assign(s.p.n, 0);
+  detail::ParticleStore::particle_columns(
+      [&](const detail::ColumnInfo& c, auto& col) { visit_column(io, "particles/", c, col, p.n); }, p);
+  io.column("particles/index_of_id", p.index_of_id);
 
   // Pairs with their history, and the contacts broken bonds left behind.
   for (auto [at, q] : {std::pair{std::string("pairs"), &s.pairs}, {std::string("inherited"), &s.inherited}}) {
@@ -208,13 +200,9 @@ void visit(Io& io, State& s) {
     io.column(at + "/a", q->a);
     io.column(at + "/b", q->b);
     if constexpr (std::is_same_v<Io, Writer>) q->columns_from_records();  // fn and U of the last step
-    for (auto [name, col] : {std::pair{"nx", &q->nx}, {"ny", &q->ny}, {"nz", &q->nz},
-                             {"fsx", &q->fsx}, {"fsy", &q->fsy}, {"fsz", &q->fsz},
-                             {"fn", &q->fn}, {"overlap", &q->overlap}})
-      io.column(at + "/" + name, *col);
     // Rest overlaps (stress-free bonds) since version 3; older files had none: all 0.
-    if (io.version >= 3) io.column(at + "/rest", q->rest);
-    else q->rest.assign(q->padded, 0.0);
+    detail::PairStore::history_columns(
+        [&](const detail::ColumnInfo& c, auto& col) { visit_column(io, at + "/", c, col, q->padded); }, *q);
     q->size_outputs();
   }
 
@@ -231,19 +219,9 @@ void visit(Io& io, State& s) {
   io.scalar("bonds/padded", b.padded);
   io.column("bonds/a", b.a);
   io.column("bonds/b", b.b);
-  for (auto [name, col] : {std::pair{"beam_radius", &b.beam_radius}, {"nx", &b.nx}, {"ny", &b.ny},
-                           {"nz", &b.nz}, {"fsx", &b.fsx}, {"fsy", &b.fsy}, {"fsz", &b.fsz},
-                           {"fn", &b.fn}, {"overlap", &b.overlap}, {"fbn", &b.fbn},
-                           {"fbsx", &b.fbsx}, {"fbsy", &b.fbsy}, {"fbsz", &b.fbsz},
-                           {"mbn", &b.mbn}, {"mbsx", &b.mbsx}, {"mbsy", &b.mbsy},
-                           {"mbsz", &b.mbsz}, {"broken", &b.broken}})
-    io.column(std::string("bonds/") + name, *col);
-  if (io.version >= 3) {
-    io.column("bonds/rest", b.rest);
-    io.flag("bonds/rest_overlaps", s.rest_overlaps);
-  } else {
-    b.rest.assign(b.padded, 0.0);
-  }
+  detail::BondStore::columns(
+      [&](const detail::ColumnInfo& c, auto& col) { visit_column(io, "bonds/", c, col, b.padded); }, b);
+  if (io.version >= 3) io.flag("bonds/rest_overlaps", s.rest_overlaps);
   b.size_outputs();
   io.scalar("bonds/material/beam_kn", b.material.beam_kn);
   io.scalar("bonds/material/beam_ks", b.material.beam_ks);
@@ -337,10 +315,8 @@ void visit(Io& io, State& s) {
   io.column("wall_contacts/wall", wc.wall);
   io.column("wall_contacts/facet", wc.facet);
   io.column("wall_contacts/start", wc.start);
-  for (auto [name, col] : {std::pair{"nx", &wc.nx}, {"ny", &wc.ny}, {"nz", &wc.nz},
-                           {"fsx", &wc.fsx}, {"fsy", &wc.fsy}, {"fsz", &wc.fsz},
-                           {"fn", &wc.fn}, {"overlap", &wc.overlap}})
-    io.column(std::string("wall_contacts/") + name, *col);
+  detail::WallContacts::history_columns(
+      [&](const detail::ColumnInfo& c, auto& col) { visit_column(io, "wall_contacts/", c, col, wc.n); }, wc);
 
   // Rigid groups.
   io.count("groups/n", s.groups);
@@ -419,19 +395,16 @@ void validate(const State& s, const std::string& path) {
   const auto& p = s.p;
   const std::size_t n = p.n, cap = p.x.size();
   need(n < (std::size_t(1) << 31) - 16 && cap >= n + 2 && cap % kMaxLanes == 0, "particles/n");
-  for (const AVec<double>* c : {&p.x, &p.y, &p.z, &p.vx, &p.vy, &p.vz, &p.wx, &p.wy, &p.wz, &p.radius,
-                                &p.mass, &p.inv_mass, &p.inertia, &p.inv_inertia, &p.fx, &p.fy, &p.fz,
-                                &p.tx, &p.ty, &p.tz, &p.x0, &p.y0, &p.z0})
-    need(c->size() == cap, "particle columns of unequal length");
-  if (p.has_applied)
-    for (const AVec<double>* c : {&p.ax, &p.ay, &p.az}) need(c->size() == cap, "particles/ax, ay, az");
-  need(p.density.size() == n && p.index_of_id.size() == n && s.user_rotation_locked.size() == n &&
-           s.bonds_broken.size() == n,
-       "particles/density, index_of_id, user_rotation_locked or bonds_broken");
-  for (std::size_t i = 0; i < n; ++i) need(s.bonds_broken[i] >= 0, "particles/bonds_broken");
-  need(p.rotation_locked.size() == cap && p.group.size() == cap && p.tag.size() == cap &&
-           p.flags.size() == cap && p.inert.size() == cap && p.id.size() == cap,
-       "particle columns of unequal length");
+  using detail::ColumnInfo;
+  using detail::ParticleStore;
+  ParticleStore::slot_columns([&](const ColumnInfo& c, const auto& col) {
+    if (!c.optional || p.has_applied) need(col.size() == cap, std::string("particles/") + c.name + ": length");
+  }, p);
+  ParticleStore::particle_columns([&](const ColumnInfo& c, const auto& col) {
+    need(col.size() == n, std::string("particles/") + c.name + ": length");
+  }, p);
+  need(p.index_of_id.size() == n, "particles/index_of_id: length");
+  for (std::size_t i = 0; i < n; ++i) need(p.bonds_broken[i] >= 0, "particles/bonds_broken");
   const auto groups = static_cast<std::int64_t>(s.groups.size());
   for (std::size_t i = 0; i < cap; ++i) {
     if (i < n) {
@@ -441,10 +414,11 @@ void validate(const State& s, const std::string& path) {
                p.inertia[i] > 0 && finite(p.inertia[i]) && p.inv_mass[i] > 0 && finite(p.inv_mass[i]) &&
                p.inv_inertia[i] > 0 && finite(p.inv_inertia[i]) && p.density[i] > 0 && finite(p.density[i]),
            "radius, mass or inertia of particle " + std::to_string(p.id[i]));
-      for (const AVec<double>* c : {&p.x, &p.y, &p.z, &p.vx, &p.vy, &p.vz, &p.wx, &p.wy, &p.wz, &p.fx,
-                                    &p.fy, &p.fz, &p.tx, &p.ty, &p.tz, &p.x0, &p.y0, &p.z0})
-        need(finite((*c)[i]), "non-finite state of particle " + std::to_string(p.id[i]));
-      if (p.has_applied) need(finite(p.ax[i]) && finite(p.ay[i]) && finite(p.az[i]), "applied force");
+      ParticleStore::slot_columns([&](const ColumnInfo& c, const auto& col) {
+        if constexpr (std::is_floating_point_v<typename std::decay_t<decltype(col)>::value_type>)
+          if (!c.optional || p.has_applied)
+            need(finite(col[i]), "non-finite state of particle " + std::to_string(p.id[i]) + " (" + c.name + ")");
+      }, p);
       need(p.group[i] >= -1 && p.group[i] < groups, "particles/group");
       need(p.inert[i] <= 1 && (!p.inert[i] || p.group[i] >= 0), "particles/inert");
     } else {
@@ -453,27 +427,31 @@ void validate(const State& s, const std::string& path) {
   }
 
   // Pair and bond lists: n entries over real particles, padding over any particle slot.
-  auto pair_like = [&](const auto& q, const char* at, std::initializer_list<const AVec<double>*> cols) {
+  // `columns` walks the store's columns (store/pairs.hpp, store/bonds.hpp).
+  auto pair_like = [&](const auto& q, const char* at, auto columns) {
     need(q.n <= q.padded && q.padded % kMaxLanes == 0 && q.a.size() == q.padded && q.b.size() == q.padded,
          std::string(at) + "/n or padded");
-    for (const AVec<double>* c : cols) need(c->size() == q.padded, std::string(at) + " columns of unequal length");
+    columns([&](const ColumnInfo& c, const auto& col) {
+      need(col.size() == q.padded, std::string(at) + "/" + c.name + ": length");
+    }, q);
     for (std::size_t k = 0; k < q.padded; ++k) {
       const auto a = q.a[k], b = q.b[k];
       if (k < q.n) {
         need(a >= 0 && b >= 0 && std::size_t(a) < n && std::size_t(b) < n && a != b,
              std::string(at) + ": entry " + std::to_string(k) + " refers to no particle");
-        for (const AVec<double>* c : cols) need(finite((*c)[k]), std::string(at) + ": non-finite value");
+        columns([&](const ColumnInfo& c, const auto& col) {
+          need(finite(col[k]), std::string(at) + ": non-finite " + c.name);
+        }, q);
       } else {
         need(a >= 0 && b >= 0 && std::size_t(a) < cap && std::size_t(b) < cap, std::string(at) + ": padding");
       }
     }
   };
-  for (const auto* q : {&s.pairs, &s.inherited})
-    pair_like(*q, q == &s.pairs ? "pairs" : "inherited",
-              {&q->nx, &q->ny, &q->nz, &q->fsx, &q->fsy, &q->fsz, &q->fn, &q->overlap, &q->rest});
+  const auto pair_columns = [](auto&& f, const detail::PairStore& q) { detail::PairStore::history_columns(f, q); };
+  const auto bond_columns = [](auto&& f, const detail::BondStore& q) { detail::BondStore::columns(f, q); };
+  for (const auto* q : {&s.pairs, &s.inherited}) pair_like(*q, q == &s.pairs ? "pairs" : "inherited", pair_columns);
   const auto& b = s.bonds;
-  pair_like(b, "bonds", {&b.beam_radius, &b.nx, &b.ny, &b.nz, &b.fsx, &b.fsy, &b.fsz, &b.fn, &b.overlap,
-                         &b.fbn, &b.fbsx, &b.fbsy, &b.fbsz, &b.mbn, &b.mbsx, &b.mbsy, &b.mbsz, &b.broken, &b.rest});
+  pair_like(b, "bonds", bond_columns);
   for (std::size_t k = 0; k < b.n; ++k) need(b.beam_radius[k] >= 0, "bonds/beam_radius");
   const BondMaterial& bm = b.material;
   need(bm.beam_kn > 0 && finite(bm.beam_kn) && bm.beam_ks > 0 && finite(bm.beam_ks) && bm.radius_factor > 0 &&

@@ -106,14 +106,12 @@ void refresh_bond_topology(State& s) {
   // intact bonds. So the lock holds while intact >= min(rotation_lock_bonds, installed): damage
   // frees the inside of the material (compression softens, scenarios.md 2.5), and an intact
   // particle with few bonds, as on a joint's face, stays locked until it is damaged.
-  s.user_rotation_locked.resize(p.n, 0);
-  s.bonds_broken.resize(p.n, 0);
   s.any_rotating = false;
   for (std::size_t i = 0; i < p.n; ++i) {
     const std::int64_t intact = s.partner_start[i + 1] - s.partner_start[i];
-    const std::int64_t needed = std::min<std::int64_t>(s.settings.rotation_lock_bonds, intact + s.bonds_broken[i]);
+    const std::int64_t needed = std::min<std::int64_t>(s.settings.rotation_lock_bonds, intact + p.bonds_broken[i]);
     const bool bonded = intact >= 1 && intact >= needed;
-    const bool locked = !s.settings.rotation || s.user_rotation_locked[i] ||
+    const bool locked = !s.settings.rotation || p.user_rotation_locked[i] ||
                         (s.settings.lock_bonded_rotation && bonded);
     if (locked && !p.rotation_locked[i]) p.wx[i] = p.wy[i] = p.wz[i] = 0;
     p.rotation_locked[i] = locked ? 1 : 0;
@@ -277,8 +275,8 @@ void process_breaks(State& s) {
     ev.released_energy = e.total - e.contact_kept;
     if (s.settings.track_energy) s.ledger.released += ev.released_energy;
     s.break_events.push_back(ev);
-    ++s.bonds_broken[a];
-    ++s.bonds_broken[b];
+    ++s.p.bonds_broken[a];
+    ++s.p.bonds_broken[b];
     // The pair enters the contact list now (the search never listed it while it was bonded),
     // unless the search never would: two members of one rigid group, or an inert particle.
     const bool listed = !p.inert[a] && !p.inert[b] && (p.group[a] < 0 || p.group[a] != p.group[b]);

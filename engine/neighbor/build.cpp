@@ -171,9 +171,7 @@ void renumber_bonds(BondStore& bq, const std::vector<std::int64_t>& new_index) {
     std::int64_t a = new_index[bq.a[k]], b = new_index[bq.b[k]];
     if (a > b) {
       std::swap(a, b);
-      for (auto* c : {&bq.nx, &bq.ny, &bq.nz, &bq.fsx, &bq.fsy, &bq.fsz, &bq.fbsx, &bq.fbsy,
-                      &bq.fbsz, &bq.mbn, &bq.mbsx, &bq.mbsy, &bq.mbsz})
-        (*c)[k] = -(*c)[k];
+      bq.swap_roles(k);
     }
     bq.a[k] = a;
     bq.b[k] = b;
@@ -232,8 +230,7 @@ void reorder(State& s, const CellGrid& g) {
     std::int64_t a = new_index[q.a[k]], b = new_index[q.b[k]];
     if (a > b) {
       std::swap(a, b);
-      q.nx[k] = -q.nx[k]; q.ny[k] = -q.ny[k]; q.nz[k] = -q.nz[k];
-      q.fsx[k] = -q.fsx[k]; q.fsy[k] = -q.fsy[k]; q.fsz[k] = -q.fsz[k];
+      q.swap_roles(k);
     }
     q.a[k] = a;
     q.b[k] = b;
@@ -265,9 +262,7 @@ void reorder(State& s, const CellGrid& g) {
   for (std::size_t k = 0; k < w.n; ++k) {
     const std::size_t o = wp[k];
     ws.particle[k] = w.particle[o]; ws.wall[k] = w.wall[o]; ws.facet[k] = w.facet[o];
-    ws.nx[k] = w.nx[o]; ws.ny[k] = w.ny[o]; ws.nz[k] = w.nz[o];
-    ws.fsx[k] = w.fsx[o]; ws.fsy[k] = w.fsy[o]; ws.fsz[k] = w.fsz[o];
-    ws.fn[k] = w.fn[o]; ws.overlap[k] = w.overlap[o];
+    WallContacts::history_columns([&](const ColumnInfo&, auto& to, const auto& from) { to[k] = from[o]; }, ws, w);
     if (w.distance.size() == w.n) ws.distance[k] = w.distance[o];
   }
   w = std::move(ws);
@@ -281,8 +276,7 @@ void reorder(State& s, const CellGrid& g) {
     std::int64_t a = new_index[ih.a[k]], b = new_index[ih.b[k]];
     if (a > b) {
       std::swap(a, b);
-      ih.nx[k] = -ih.nx[k]; ih.ny[k] = -ih.ny[k]; ih.nz[k] = -ih.nz[k];
-      ih.fsx[k] = -ih.fsx[k]; ih.fsy[k] = -ih.fsy[k]; ih.fsz[k] = -ih.fsz[k];
+      ih.swap_roles(k);
     }
     ih.a[k] = a;
     ih.b[k] = b;
@@ -292,18 +286,6 @@ void reorder(State& s, const CellGrid& g) {
       for (auto& m : *list) m = std::int32_t(new_index[m]);
       std::sort(list->begin(), list->end());
     }
-  }
-  s.user_rotation_locked.resize(p.n, 0);
-  {
-    std::vector<std::uint8_t> ul(p.n);
-    for (std::size_t i = 0; i < p.n; ++i) ul[i] = s.user_rotation_locked[order[i]];
-    s.user_rotation_locked.swap(ul);
-  }
-  s.bonds_broken.resize(p.n, 0);
-  {
-    std::vector<std::int32_t> lost(p.n);
-    for (std::size_t i = 0; i < p.n; ++i) lost[i] = s.bonds_broken[order[i]];
-    s.bonds_broken.swap(lost);
   }
   refresh_bond_topology(s);
   ++s.reorders;
@@ -476,17 +458,11 @@ void build_wall_contacts(State& s) {
   for (k = 0; k < total; ++k) {
     const auto key = std::tie(fresh.particle[k], fresh.wall[k], fresh.facet[k]);
     while (o < old.n && std::tie(old.particle[o], old.wall[o], old.facet[o]) < key) ++o;
-    if (o < old.n && std::tie(old.particle[o], old.wall[o], old.facet[o]) == key) {
-      fresh.nx[k] = old.nx[o]; fresh.ny[k] = old.ny[o]; fresh.nz[k] = old.nz[o];
-      fresh.fsx[k] = old.fsx[o]; fresh.fsy[k] = old.fsy[o]; fresh.fsz[k] = old.fsz[o];
-      fresh.fn[k] = old.fn[o]; fresh.overlap[k] = old.overlap[o];
-    } else {
-      // No history yet: the wall kernel treats a zero normal as "take the current one".
-      fresh.nx[k] = fresh.ny[k] = fresh.nz[k] = 0;
-      fresh.fsx[k] = fresh.fsy[k] = fresh.fsz[k] = 0;
-      fresh.fn[k] = 0;
-      fresh.overlap[k] = -1;
-    }
+    const bool known = o < old.n && std::tie(old.particle[o], old.wall[o], old.facet[o]) == key;
+    // No history yet: the pads (a zero normal, which the wall kernel takes as "the current one").
+    WallContacts::history_columns([&](const ColumnInfo& c, auto& to, const auto& from) {
+      to[k] = known ? from[o] : c.pad;
+    }, fresh, old);
   }
   s.walls.contacts = std::move(fresh);
 }

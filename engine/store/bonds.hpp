@@ -11,6 +11,7 @@
 
 #include "asperity/world.hpp"
 #include "core/aligned.hpp"
+#include "store/columns.hpp"
 
 namespace asperity::detail {
 
@@ -43,13 +44,36 @@ struct BondStore {
   BondMaterial material;
   bool any = false;                       // a material was set by a first installation
 
+  // Every column but a and b once: f(info, this column of each of `q`...). What a copy carries,
+  // a reorder flips and a checkpoint saves.
+  template <class F, class... Stores>
+  static void columns(F&& f, Stores&... q) {
+    f(ColumnInfo{"beam_radius", 0}, q.beam_radius...);  // 0 in padding: never acts or breaks
+    f(ColumnInfo{"nx", 1, true}, q.nx...);
+    f(ColumnInfo{"ny", 0, true}, q.ny...);
+    f(ColumnInfo{"nz", 0, true}, q.nz...);
+    f(ColumnInfo{"fsx", 0, true}, q.fsx...);
+    f(ColumnInfo{"fsy", 0, true}, q.fsy...);
+    f(ColumnInfo{"fsz", 0, true}, q.fsz...);
+    f(ColumnInfo{"fn", 0}, q.fn...);
+    f(ColumnInfo{"overlap", 0}, q.overlap...);
+    f(ColumnInfo{"rest", 0, false, 3}, q.rest...);
+    f(ColumnInfo{"fbn", 0}, q.fbn...);
+    f(ColumnInfo{"fbsx", 0, true}, q.fbsx...);
+    f(ColumnInfo{"fbsy", 0, true}, q.fbsy...);
+    f(ColumnInfo{"fbsz", 0, true}, q.fbsz...);
+    f(ColumnInfo{"mbn", 0, true}, q.mbn...);
+    f(ColumnInfo{"mbsx", 0, true}, q.mbsx...);
+    f(ColumnInfo{"mbsy", 0, true}, q.mbsy...);
+    f(ColumnInfo{"mbsz", 0, true}, q.mbsz...);
+    f(ColumnInfo{"broken", 0}, q.broken...);
+  }
+
   void resize(std::size_t count) {
     n = count;
     padded = round_up(count, kMaxLanes);
     for (auto* c : {&a, &b}) c->resize(padded);
-    for (auto* c : {&beam_radius, &nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &overlap, &rest, &fbn, &fbsx,
-                    &fbsy, &fbsz, &mbn, &mbsx, &mbsy, &mbsz, &broken})
-      c->resize(padded);
+    columns([&](const ColumnInfo&, auto& c) { c.resize(padded); }, *this);
     size_outputs();
   }
   // The gather's columns are not saved: a store read from a checkpoint sizes them here.
@@ -57,25 +81,20 @@ struct BondStore {
     out.resize(kBondRecord * padded);
   }
   void fill_padding(std::int64_t null_a, std::int64_t null_b) {
-    for (std::size_t i = n; i < padded; ++i) {
-      a[i] = null_a;
-      b[i] = null_b;
-      beam_radius[i] = 0;
-      nx[i] = 1;
-      ny[i] = nz[i] = fsx[i] = fsy[i] = fsz[i] = fn[i] = overlap[i] = rest[i] = fbn[i] = 0;
-      fbsx[i] = fbsy[i] = fbsz[i] = mbn[i] = mbsx[i] = mbsy[i] = mbsz[i] = broken[i] = 0;
-      for (std::size_t j = 0; j < kBondRecord; ++j) out[kBondRecord * i + j] = 0;
-    }
+    pad_column(a, n, padded, double(null_a));
+    pad_column(b, n, padded, double(null_b));
+    columns([&](const ColumnInfo& c, auto& col) { pad_column(col, n, padded, c.pad); }, *this);
+    std::fill(out.begin() + std::ptrdiff_t(kBondRecord * n), out.begin() + std::ptrdiff_t(kBondRecord * padded), 0.0);
   }
   // Copy bond o of `from` into slot k of this store.
   void copy_from(const BondStore& from, std::size_t o, std::size_t k) {
-    a[k] = from.a[o]; b[k] = from.b[o]; beam_radius[k] = from.beam_radius[o];
-    nx[k] = from.nx[o]; ny[k] = from.ny[o]; nz[k] = from.nz[o];
-    fsx[k] = from.fsx[o]; fsy[k] = from.fsy[o]; fsz[k] = from.fsz[o];
-    fn[k] = from.fn[o]; overlap[k] = from.overlap[o]; rest[k] = from.rest[o]; fbn[k] = from.fbn[o];
-    fbsx[k] = from.fbsx[o]; fbsy[k] = from.fbsy[o]; fbsz[k] = from.fbsz[o];
-    mbn[k] = from.mbn[o]; mbsx[k] = from.mbsx[o]; mbsy[k] = from.mbsy[o]; mbsz[k] = from.mbsz[o];
-    broken[k] = from.broken[o];
+    a[k] = from.a[o];
+    b[k] = from.b[o];
+    columns([&](const ColumnInfo&, auto& to, const auto& src) { to[k] = src[o]; }, *this, from);
+  }
+  // Bond k seen from the other side (a and b swap roles, as a renumbering may ask).
+  void swap_roles(std::size_t k) {
+    columns([&](const ColumnInfo& c, auto& col) { if (c.flips) col[k] = -col[k]; }, *this);
   }
 };
 

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/aligned.hpp"
+#include "store/columns.hpp"
 
 namespace asperity::detail {
 
@@ -74,11 +75,26 @@ struct PairStore {
     outputs_in_records = false;
   }
 
+  // Every history column once: f(info, this column of each of `q`...). The history a rebuild
+  // carries over, a reorder flips and a checkpoint saves (besides a and b).
+  template <class F, class... Stores>
+  static void history_columns(F&& f, Stores&... q) {
+    f(ColumnInfo{"nx", 1, true}, q.nx...);  // unit normal along x in padding
+    f(ColumnInfo{"ny", 0, true}, q.ny...);
+    f(ColumnInfo{"nz", 0, true}, q.nz...);
+    f(ColumnInfo{"fsx", 0, true}, q.fsx...);
+    f(ColumnInfo{"fsy", 0, true}, q.fsy...);
+    f(ColumnInfo{"fsz", 0, true}, q.fsz...);
+    f(ColumnInfo{"fn", 0}, q.fn...);
+    f(ColumnInfo{"overlap", -1}, q.overlap...);  // padding pairs never touch
+    f(ColumnInfo{"rest", 0, false, 3}, q.rest...);
+  }
+
   void resize(std::size_t count) {
     n = count;
     padded = round_up(count, kMaxLanes);
     for (auto* c : {&a, &b}) c->resize(padded);
-    for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &overlap, &rest}) c->resize(padded);
+    history_columns([&](const ColumnInfo&, auto& c) { c.resize(padded); }, *this);
     size_outputs();  // which also marks the columns as current
   }
   // The gather's columns are not saved: a store read from a checkpoint sizes them here.
@@ -89,23 +105,25 @@ struct PairStore {
     live_current = false;
     outputs_in_records = false;
   }
-  // Padding entries: pair of two null particles, unit normal along x, no force.
+  // Padding entries: pair of two null particles, no force, not touching.
   void fill_padding(std::int64_t null_a, std::int64_t null_b) {
+    pad_column(a, n, padded, double(null_a));
+    pad_column(b, n, padded, double(null_b));
+    history_columns([&](const ColumnInfo& c, auto& col) { pad_column(col, n, padded, c.pad); }, *this);
     for (std::size_t i = n; i < padded; ++i) {
-      a[i] = null_a;
-      b[i] = null_b;
-      nx[i] = 1;
-      ny[i] = nz[i] = fsx[i] = fsy[i] = fsz[i] = fn[i] = rest[i] = 0;
-      overlap[i] = -1;
       for (std::size_t j = 0; j < kPairRecord; ++j) out[kPairRecord * i + j] = 0;
       out[kPairRecord * i + 3] = -1;
     }
   }
   // Copy the history of pair o of `from` into slot k of this store.
   void copy_history(const PairStore& from, std::size_t o, std::size_t k) {
-    nx[k] = from.nx[o]; ny[k] = from.ny[o]; nz[k] = from.nz[o];
-    fsx[k] = from.fsx[o]; fsy[k] = from.fsy[o]; fsz[k] = from.fsz[o];
-    fn[k] = from.normal_force(o); overlap[k] = from.overlap_at(o); rest[k] = from.rest[o];
+    history_columns([&](const ColumnInfo&, auto& to, const auto& src) { to[k] = src[o]; }, *this, from);
+    fn[k] = from.normal_force(o);  // the last step's, wherever they are
+    overlap[k] = from.overlap_at(o);
+  }
+  // Pair k seen from the other side (a and b swap roles, as a renumbering may ask).
+  void swap_roles(std::size_t k) {
+    history_columns([&](const ColumnInfo& c, auto& col) { if (c.flips) col[k] = -col[k]; }, *this);
   }
 };
 

@@ -7,6 +7,7 @@
 
 #include "asperity/world.hpp"
 #include "core/aligned.hpp"
+#include "store/columns.hpp"
 
 namespace asperity::detail {
 
@@ -78,10 +79,26 @@ struct WallContacts {
   std::vector<double> distance;
   std::vector<std::int32_t> start;  // per particle offsets (CSR), particles + 1
 
+  // The history columns once: f(info, this column of each of `q`...). What a rebuild carries
+  // over (a contact new to the list takes the pads: a zero normal is "take the current one"),
+  // a reorder copies and a checkpoint saves (besides particle, wall, facet and start).
+  template <class F, class... Stores>
+  static void history_columns(F&& f, Stores&... q) {
+    f(ColumnInfo{"nx", 0}, q.nx...);
+    f(ColumnInfo{"ny", 0}, q.ny...);
+    f(ColumnInfo{"nz", 0}, q.nz...);
+    f(ColumnInfo{"fsx", 0}, q.fsx...);
+    f(ColumnInfo{"fsy", 0}, q.fsy...);
+    f(ColumnInfo{"fsz", 0}, q.fsz...);
+    f(ColumnInfo{"fn", 0}, q.fn...);
+    f(ColumnInfo{"overlap", -1}, q.overlap...);
+  }
+
   void resize(std::size_t count) {
     n = count;
     for (auto* c : {&particle, &wall, &facet}) c->resize(count);
-    for (auto* c : {&nx, &ny, &nz, &fsx, &fsy, &fsz, &fn, &overlap, &slip, &distance}) c->resize(count);
+    history_columns([&](const ColumnInfo&, auto& c) { c.resize(count); }, *this);
+    for (auto* c : {&slip, &distance}) c->resize(count);
   }
 };
 
