@@ -502,15 +502,7 @@ void check_motion(const State& s, const GroupMotion& motion, bool has_inert, con
     if (motion.translation[k] != Dof::servo) continue;
     const Servo& sv = motion.servo[k];
     const std::string where = at + "servo on " + axis[k] + ": ";
-    require(std::isfinite(sv.target_force), where + "target_force must be finite, got " + num(sv.target_force));
-    require(std::isfinite(sv.stiffness) && sv.stiffness >= 0,
-            where + "stiffness must be >= 0 (N/m), got " + num(sv.stiffness));
-    require(std::isfinite(sv.gain) && sv.gain >= 0, where + "gain must be >= 0 (0: automatic), got " + num(sv.gain));
-    require(sv.relaxation > 0 && sv.relaxation <= 1, where + "relaxation must be in (0, 1], got " + num(sv.relaxation));
-    require(sv.max_velocity > 0 && std::isfinite(sv.max_velocity),
-            where + "max_velocity must be > 0 (m/s), got " + num(sv.max_velocity));
-    require(std::isfinite(sv.integral_time) && sv.integral_time >= 0,
-            where + "integral_time must be >= 0 (s; 0: proportional only), got " + num(sv.integral_time));
+    for_each_field(sv, [&](const Field& f, double v) { check_value(where, f, v); });
   }
   require(std::isfinite(motion.damping) && motion.damping < 1,
           at + "group damping must be below 1 (a negative value: the world's local damping), got " +

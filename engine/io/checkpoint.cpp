@@ -347,12 +347,9 @@ void visit(Io& io, State& s) {
     io.vec(at + "/motion_angular_velocity", m.angular_velocity);
     for (int k = 0; k < 3; ++k) {
       const std::string sv = at + "/servo" + std::to_string(k);
-      io.scalar(sv + "/target_force", m.servo[k].target_force);
-      io.scalar(sv + "/stiffness", m.servo[k].stiffness);
-      io.scalar(sv + "/gain", m.servo[k].gain);
-      io.scalar(sv + "/relaxation", m.servo[k].relaxation);
-      io.scalar(sv + "/max_velocity", m.servo[k].max_velocity);
-      if (io.version >= 2) io.scalar(sv + "/integral_time", m.servo[k].integral_time);
+      for_each_field(m.servo[k], [&](const Field& f, double& v) {
+        if (io.version >= f.since) io.scalar(sv + "/" + f.stored, v);
+      });
     }
     if (io.version >= 2) io.scalar(at + "/damping", m.damping);
   }
@@ -531,10 +528,9 @@ void validate(const State& s, const std::string& path) {
              m.damping < 1,
          "group " + std::to_string(g) + " motion");
     for (const Servo& sv : m.servo)
-      need(finite(sv.target_force) && sv.stiffness >= 0 && finite(sv.stiffness) && sv.gain >= 0 && finite(sv.gain) &&
-               sv.relaxation > 0 && sv.relaxation <= 1 && sv.max_velocity > 0 && finite(sv.max_velocity) &&
-               sv.integral_time >= 0 && finite(sv.integral_time),
-           "group " + std::to_string(g) + " servo");
+      for_each_field(sv, [&](const Field& f, double v) {
+        need(f.range.contains(v), "group " + std::to_string(g) + " servo " + f.name);
+      });
   }
 }
 

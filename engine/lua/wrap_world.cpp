@@ -416,25 +416,17 @@ const char* dof_name(Dof d) {
 
 Servo servo_fields(lua_State* L, int index, const std::string& context, Servo s) {
   Options o(L, index, context, 0);
-  s.target_force = o.number("target_force", s.target_force);
-  s.stiffness = o.number("stiffness", s.stiffness);
-  s.gain = o.number("gain", s.gain);
-  s.relaxation = o.number("relaxation", s.relaxation);
-  s.max_velocity = o.number("max_velocity", s.max_velocity);
-  s.integral_time = o.number("integral_time", s.integral_time);
+  for_each_field(s, [&](const Field& f, double& v) { v = o.number(f.name, v); });
   o.finish();
   return s;
 }
 
 void push_servo(lua_State* L, const Servo& s) {
-  lua_createtable(L, 0, 5);
-  auto num = [&](const char* f, double v) { lua_pushnumber(L, v); lua_setfield(L, -2, f); };
-  num("target_force", s.target_force);
-  num("stiffness", s.stiffness);
-  num("gain", s.gain);
-  num("relaxation", s.relaxation);
-  num("max_velocity", s.max_velocity);
-  num("integral_time", s.integral_time);
+  lua_createtable(L, 0, 6);
+  for_each_field(s, [&](const Field& f, double v) {
+    lua_pushnumber(L, v);
+    lua_setfield(L, -2, f.name);
+  });
 }
 
 // motion = {translation = "free"|"fixed"|"velocity"|"servo" or one per axis, velocity = vec,

@@ -172,6 +172,24 @@ struct Servo {
                               // lags by v/G whenever the specimen dilates at a steady rate
 };
 
+// visit(field, member) for each field of a servo (checked when a motion is set, read and pushed by
+// the Lua binding, saved by a checkpoint).
+template <class S, class Visit>
+  requires std::is_same_v<std::remove_const_t<S>, Servo>
+void for_each_field(S& s, Visit&& visit) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  visit(Field{"target_force", "target_force", 1, {-inf, inf, true, true, nullptr, "N"}, "N"}, s.target_force);
+  visit(Field{"stiffness", "stiffness", 1, {0, inf, false, true, nullptr, "N/m"}, "N/m; 0: constant normal load"},
+        s.stiffness);
+  visit(Field{"gain", "gain", 1, {0, inf, false, true}, "m/s per N; 0: automatic"}, s.gain);
+  visit(Field{"relaxation", "relaxation", 1, {0, 1, true, false}, "error corrected per step (automatic gain)"},
+        s.relaxation);
+  visit(Field{"max_velocity", "max_velocity", 1, {0, inf, true, true, nullptr, "m/s"}, "m/s"}, s.max_velocity);
+  visit(Field{"integral_time", "integral_time", 2, {0, inf, false, true, nullptr, "s"},
+              "s; 0: proportional only"},
+        s.integral_time);
+}
+
 struct GroupMotion {
   std::array<Dof, 3> translation{Dof::free, Dof::free, Dof::free};
   Vec3 velocity{0, 0, 0};          // used on the axes whose mode is Dof::velocity

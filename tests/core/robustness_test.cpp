@@ -46,7 +46,7 @@ TEST(Robustness, AFailedAddGroupLeavesTheWorldAsItWas) {
   m.translation = {Dof::free, Dof::free, Dof::servo};
   m.servo[2].max_velocity = -1;
   const std::int64_t ids[] = {0, 1};
-  EXPECT_NE(error_of([&] { w.add_group(ids, m); }).find("servo on z: max_velocity must be > 0"), std::string::npos);
+  EXPECT_NE(error_of([&] { w.add_group(ids, m); }).find("servo on z: max_velocity -1 outside (0, inf) m/s"), std::string::npos);
   EXPECT_EQ(w.group_count(), 0u);
   EXPECT_EQ(w.group_of(0), -1);
   EXPECT_EQ(w.group_of(1), -1);

@@ -79,7 +79,7 @@ refuses("triangle 0 is degenerate", w.add_mesh, w,
 
 -- A group with an invalid servo: refused whole, nothing half-added; the next steps run.
 local groups = w:group_count()
-refuses("max_velocity must be > 0", w.add_group, w, {1, 2},
+refuses("max_velocity %-1 outside %(0, inf%) m/s", w.add_group, w, {1, 2},
         {translation = {"free", "free", "servo"}, servo = {max_velocity = -1}})
 assert(w:group_count() == groups and w:group_of(1) == nil and w:group_of(2) == nil)
 w:cycle(5)
