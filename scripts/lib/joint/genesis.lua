@@ -70,9 +70,8 @@ local function build(run)
   local w = asperity.world{material = mat.contact, damping = mat.damping, density = mat.density,
                            threads = P.threads, rotation_lock_bonds = mat.rev.rotation_lock_bonds}
   -- Boxes: sides, floor of the lower half, roof of the upper one; the mould between them. Made here
-  -- rather than by lib/walls.lua, whose box adds the same planes in another order: the order of the
-  -- walls is the order in which a particle's wall forces are summed, and the packing would differ
-  -- in its last digits.
+  -- rather than by lib/walls.lua, whose box adds the same planes in another order and through other
+  -- points: the cached checkpoint keeps the walls as they were added, so its file would change.
   local wm = {kn = mat.contact.kn, ks = mat.contact.ks, friction = P.wall_friction}
   local planes = {
     w:add_plane{point = {0, 0, 0}, normal = {1, 0, 0}, material = wm},
