@@ -1,0 +1,208 @@
+-- The shear of a closed joint (scripts/joint.lua) under constant normal load or stiffness [thesis
+-- 4.3.1]: the upper platen moves `shear` mm along -direction at `velocity`, ramped up over `ramp`.
+--
+--   require("joint.shear").run(run)   -- run.shear (series), run.e0, run.shear_impulse, ...
+--
+-- Writes shear.{h5,csv} (one row per `record` mm), the snapshots joint.xdmf at the `snapshots`
+-- displacements (XDMF time: shear displacement, mm), events.{h5,csv} with events_every, and
+-- breaks.{h5,csv} when bonds broke.
+local mat = require("materials")
+local params_lib = require("params")
+local context = require("joint.context")
+
+local MODEL_PA, ROCK_MPA = context.MODEL_PA, context.ROCK_MPA
+
+local M = {}
+
+-- Constant normal load. "load": the platen is free along z under a constant applied force, a dead
+-- weight, undamped (local damping would bias the load it transmits by alpha times the mean force
+-- noise): it follows any dilatancy at once and the load it transmits differs from the target only
+-- by its inertia. "servo" (model.md 7): the platen's z velocity follows the force error, with
+-- integral action (servo_integral_steps) so that a steady dilatancy rate leaves no lag.
+-- "stiffness": the same servo, its target rising by normal_stiffness x the platen's rise (constant
+-- normal stiffness, the engine's servo `stiffness`); it settles on sigma_0 like the CNL servo, and
+-- the stiffness is switched on when the shear starts, so the dilatancy it acts on is the recorded one.
+-- Returns the translation modes of the upper platen while shearing.
+local function normal_control(run)
+  local P, world, top, axis = run.P, run.world, run.top, run.axis
+  local area, target_stress = run.area, run.target_stress
+  local shear_velocity = {0, 0, 0}
+  shear_velocity[axis] = -P.velocity
+  local servo_control = P.normal_control == "servo" or P.normal_control == "stiffness"
+  local modes = {"fixed", "fixed", servo_control and "servo" or "free"}
+  modes[axis] = "velocity"
+  if servo_control then
+    world:set_group_motion(top, {translation = modes, velocity = shear_velocity,
+                                 servo = {target_force = target_stress * area, max_velocity = P.servo_max_velocity * P.velocity,
+                                          relaxation = P.servo_relaxation,
+                                          integral_time = P.servo_integral_steps * world:dt()}})
+  elseif P.normal_control == "load" then
+    world:set_group_motion(top, {translation = modes, velocity = shear_velocity, damping = P.platen_damping})
+    run.applied_z = -target_stress * area
+    world:set_group_force(top, {0, 0, run.applied_z})
+  else
+    error("normal_control must be servo, load or stiffness, got '" .. P.normal_control .. "'")
+  end
+  -- Let the platen settle on the target load before shearing.
+  local hold = {table.unpack(modes)}
+  hold[axis] = "fixed"
+  local v0 = {0, 0, 0}
+  world:set_group_motion(top, {translation = hold, velocity = v0})
+  local n = world:run{steps = 200000, every = 100, progress = P.progress,
+            stop_when = function(w)
+              return math.abs(run:normal_stress() / target_stress - 1) < 0.002 and w:unbalanced_force_ratio() < 1e-3
+            end}
+  run:log("settled on the normal load in %d steps", n)
+  return modes
+end
+
+-- Every bond break while shearing (model.md 5), for the event statistics and maps.
+local function write_breaks(run, breaks_before)
+  local world = run.world
+  if world:break_count() <= breaks_before then return end
+  local breaks = asperity.series{"step [1]", "time [s]", "x [m]", "y [m]", "z [m]", "mode [1]", "sigma [Pa]",
+                                 "tau [Pa]", "released_energy [J]"}
+  breaks:set_attribute("mode", "1 tension, 2 compression, 3 shear")
+  local mode_code = {tension = 1, compression = 2, shear = 3}
+  for _, ev in ipairs(world:break_events(breaks_before + 1)) do
+    breaks:record(ev.step, ev.time, ev.position[1], ev.position[2], ev.position[3], mode_code[ev.mode] or 0,
+                  ev.sigma, ev.tau, ev.released_energy)
+  end
+  breaks:write(run.P.out .. "/breaks")
+end
+
+function M.run(run)
+  local P, world, top, area = run.P, run.world, run.top, run.area
+  run.axis = P.direction == "x" and 1 or 2
+  local axis = run.axis
+  -- MPa/mm scaled -> N/m of the platen: model Pa per m of rise, times the area.
+  local cns_stiffness = P.normal_control == "stiffness" and P.normal_stiffness * 1e6 / run.stress_scale * 1e3 * area or 0
+  local modes = normal_control(run)
+  local shear = asperity.series{"displacement [mm]", "shear_stress [" .. MODEL_PA .. "]", "shear_stress_mpa [" .. ROCK_MPA .. "]",
+    "normal_stress_mpa [" .. ROCK_MPA .. "]", "normal_stress_mean_mpa [" .. ROCK_MPA .. "]", "dilatancy [mm]", "contacts [1]", "contact_area [%]",
+    "broken_bonds [1]", "porosity_shear_stress_mpa [" .. ROCK_MPA .. "]", "kinetic [J]", "strain [J]",
+    "friction [J]", "damping [J]", "released [J]", "boundary_work [J]", "shear_work [J]",
+    "dilatancy_work [J]", "time [s]"}
+  run.shear = shear
+  run.c0 = world:group_position(top)
+  run.e0 = world:energies()
+  local c0, e0 = run.c0, run.e0
+  local shear_work, dilatancy_work = 0, 0
+  local last_pos, last_force = c0, run:platen_force()
+  local snaps = run:snapshots("joint", "shear displacement (mm)")
+  local snap_at = {}
+  for _, v in ipairs(params_lib.split(P.snapshots, true)) do snap_at[#snap_at + 1] = v end
+  table.sort(snap_at)
+  local next_snap = 1
+  -- The contact points between the halves at the highest shear stress so far: at the end, those of
+  -- the peak (for its contact map).
+  local peak_seen = -math.huge
+  -- The normal stress averaged over each recording interval, as a load cell with a low-pass filter
+  -- reads it (the instantaneous value also carries the platen's inertia at each slip event of the
+  -- soft model): the change of the platen's impulse over the change of time, so nothing has to be
+  -- sampled every step.
+  local last_impulse, last_time = world:group_impulse(top)[3], world:time()
+  -- Quasi-static check: the specimen's kinetic energy against the work of the normal load over one
+  -- mean radius. A rate-independent (quasi-static) test keeps it small; a start-up impact or a
+  -- loading rate too high for the material shows up here long before the health checks.
+  run.dynamic_ratio, run.dynamic_at = 0, 0
+  local energy_scale = run.target_stress * area * mat.packing.mean_radius
+  run.shear_impulse = {}   -- platen impulse along the shear axis, one per record
+  local function record_shear()
+    local p, f = world:group_position(top), run:platen_force()
+    local impulse, now = world:group_impulse(top), world:time()
+    local sn_mean = now > last_time and ((impulse[3] - last_impulse) / (now - last_time) - run.applied_z) / area or f[3] / area
+    last_impulse, last_time = impulse[3], now
+    -- Work of the agent on the specimen: the force it applies is minus the particles' force.
+    shear_work = shear_work - 0.5 * (f[axis] + last_force[axis]) * (p[axis] - last_pos[axis])
+    dilatancy_work = dilatancy_work - 0.5 * (f[3] + last_force[3]) * (p[3] - last_pos[3])
+    last_pos, last_force = p, f
+    local c = run:between()
+    local tau = f[axis] / area   -- the lower half resists the upper one moving along -axis
+    local e = world:energies()
+    if e.kinetic / energy_scale > run.dynamic_ratio then
+      run.dynamic_ratio, run.dynamic_at = e.kinetic / energy_scale, run:displacement()
+    end
+    run:track_overlap(("%.3f mm of shear"):format(run:displacement()))
+    run.shear_impulse[#run.shear_impulse + 1] = impulse[axis]
+    shear:record(run:displacement(), tau, run:mpa(tau), run:mpa(f[3] / area), run:mpa(sn_mean), (p[3] - c0[3]) * 1e3,
+                 c.count, 100 * c.area / area, world:break_count(), run:mpa(c.flagged_force[axis] / area),
+                 e.kinetic, e.strain - e0.strain, e.friction - e0.friction, e.damping - e0.damping,
+                 e.released - e0.released, e.boundary_work - e0.boundary_work, shear_work,
+                 dilatancy_work, world:time())
+    if run:mpa(tau) > peak_seen then
+      peak_seen, run.peak_points = run:mpa(tau), {at = run:displacement(), step = world:step(), points = run:points_between()}
+    end
+    while next_snap <= #snap_at and run:displacement() >= snap_at[next_snap] - 1e-9 do
+      snaps:write(world, {stage = "shear", shear_displacement_mm = run:displacement(), stress_scale = run.stress_scale},
+                  run:displacement())
+      next_snap = next_snap + 1
+    end
+  end
+  record_shear()
+  local record_every = math.max(1, math.floor(P.record * 1e-3 / (P.velocity * world:dt()) + 0.5))
+  -- Event statistics (scenarios.md 8): the energies every `events_every` steps while shearing; the
+  -- breaks themselves come from world:break_events. The run then calls back every step, so the records
+  -- and the velocity ramp keep their steps (reading the energies still moves a chaotic run in its last
+  -- digits: scripts/README.md).
+  local events, sample_every, breaks_before = nil, record_every, world:break_count()
+  if P.events_every > 0 then
+    sample_every = 1
+    events = asperity.series{"step [1]", "displacement [mm]", "broken_bonds [1]", "kinetic [J]", "strain [J]",
+                             "damping [J]", "friction [J]", "released [J]"}
+  end
+  local function record_events()
+    local en = world:energies()
+    events:record(world:step(), run:displacement(), world:break_count() - breaks_before, en.kinetic, en.strain,
+                  en.damping, en.friction, en.released)
+  end
+  if run.escape_every > 0 then run:set_escape_box(P.shear * 1e-3) end
+  local shear_t0, shear_s0, shear_r0 = asperity.wall_time(), world:step(), world:stats().rebuilds
+  -- The shear velocity rises linearly over `ramp` mm (time 2 ramp / v), in one stage per record.
+  local ramp_stages = P.ramp > 0 and math.max(1, math.ceil(2 * P.ramp * 1e-3 / P.velocity / world:dt() / record_every)) or 1
+  local function set_shear_velocity(stage)
+    local v = {0, 0, 0}
+    v[axis] = -P.velocity * math.min(1, stage / ramp_stages)
+    world:set_group_motion(top, {translation = modes, velocity = v})
+  end
+  if cns_stiffness > 0 then world:set_group_motion(top, {servo = {stiffness = cns_stiffness}}) end
+  set_shear_velocity(1)
+  local stage = 1
+  if events then record_events() end
+  world:run{steps = 100000000, every = sample_every, progress = P.progress,
+            callback = function()
+              if events then
+                local k = world:step() - shear_s0
+                if k % P.events_every == 0 then record_events() end
+                if k % record_every ~= 0 then return end
+              end
+              record_shear()
+              if run.escape_every > 0 then run:remove_escaped() end
+              if stage < ramp_stages then stage = stage + 1; set_shear_velocity(stage) end
+            end,
+            -- stop less than one record before the end; the last stretch is stepped singly below, so
+            -- every run ends at `shear` exactly and the residual's window is always the same
+            stop_when = function(w)
+              return run:displacement() >= P.shear - 1e3 * P.velocity * w:dt() * (record_every + 1)
+            end,
+            fraction = function() return run:displacement() / P.shear end,
+            show = function()
+              return {disp_mm = run:displacement(), tau_mpa = run:mpa(run:platen_force()[axis] / area),
+                      sigma_mpa = run:mpa(run:normal_stress())}
+            end}
+  world:run{steps = 100000000, every = 1, stop_when = function() return run:displacement() >= P.shear end}
+  record_shear()
+  if P.save ~= "" then
+    world:save(P.save)
+    run:log("saved the world at %.3f mm of shear to %s", run:displacement(), P.save)
+  end
+  run.shear_seconds, run.shear_steps = asperity.wall_time() - shear_t0, world:step() - shear_s0
+  run.shear_rebuilds = world:stats().rebuilds - shear_r0
+  run:label_series(shear)
+  shear:write(P.out .. "/shear")
+  if events then events:write(P.out .. "/events") end
+  write_breaks(run, breaks_before)
+  run:log("sheared %.2f mm", run:displacement())
+end
+
+return M
