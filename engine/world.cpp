@@ -5,6 +5,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -853,6 +854,54 @@ std::uint64_t World::cycle(std::uint64_t n) {
     throw;
   }
   return n;
+}
+RunResult World::run(const RunPlan& plan) {
+  require(plan.steps > 0 || plan.until_equilibrium || plan.stop_when,
+          "run: give steps and/or a stop condition (stop_when or equilibrium)");
+  require(plan.every >= 1, "run: every must be >= 1");
+  require(plan.ratio > 0, "run: ratio " + num(plan.ratio) + " must be > 0");
+  // A stop request outlives neither the run it ended nor one that failed in a hook.
+  struct ForgetStop {
+    State& s;
+    ~ForgetStop() { s.stop_requested.store(false); }
+  } forget{*state_};
+  using Clock = std::chrono::steady_clock;
+  const std::uint64_t limit = plan.steps > 0 ? plan.steps : std::numeric_limits<std::uint64_t>::max();
+  const bool checks = plan.until_equilibrium || plan.stop_when || plan.callback;
+  const std::uint64_t every = plan.every;
+  RunResult r;
+  std::uint64_t chunk = 1;
+  while (r.steps < limit) {
+    // Chunks of ~50 ms keep progress reports and interruptions responsive at no measurable cost
+    // per call; they end at every check.
+    std::uint64_t n = std::min(chunk, limit - r.steps);
+    if (checks) n = std::min(n, every - r.steps % every);
+    const auto t0 = Clock::now();
+    const std::uint64_t done = cycle(n);
+    r.steps += done;
+    if (done < n || (plan.interrupted && plan.interrupted())) {
+      r.end = RunResult::End::interrupted;
+      return r;
+    }
+    const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    if (seconds < 0.02 && chunk < (1u << 20)) chunk *= 2;
+    else if (seconds > 0.1 && chunk > 1) chunk /= 2;
+    if (checks && r.steps % every == 0) {
+      if (plan.callback) plan.callback();
+      if (plan.until_equilibrium) {
+        r.ratio = unbalanced_force_ratio();
+        if (r.ratio <= plan.ratio) {
+          r.end = RunResult::End::equilibrium;
+          break;
+        }
+      } else if (plan.stop_when && plan.stop_when()) {
+        r.end = RunResult::End::stop_when;
+        break;
+      }
+    }
+    if (plan.on_chunk) plan.on_chunk(r.steps, r.ratio);
+  }
+  return r;
 }
 void World::request_stop() { state_->stop_requested.store(true); }
 double World::dt() const { return state_->dt; }

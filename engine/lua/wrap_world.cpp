@@ -2,8 +2,8 @@
 //
 // Each method checks its arguments, makes one engine call and pushes the result (binding.hpp).
 // The exceptions to "one call": bulk writes from an Array (a loop in C over the per-particle
-// setters, still one Lua call), group predicates (one Lua call per particle: it is the user's
-// function), and world:run, the run loop with its stop condition, callback and progress line.
+// setters, still one Lua call) and group predicates (one Lua call per particle: it is the user's
+// function). world:run hands World::run its stop condition, callback and progress line as hooks.
 //
 // Ids count from 1 in Lua (particles, walls, groups); the engine counts from 0.
 // Wall materials default to the world's contact material, not to the C++ default, so that
@@ -903,15 +903,18 @@ int world_group_count(lua_State* L) {
 // ---------------------------------------------------------------------------------------------
 // Running
 
+[[noreturn]] void throw_interrupted(const World& w) {
+  throw Interrupted("interrupted at step " + std::to_string(w.step_count()) +
+                    " (the world is intact: continue with world:cycle or world:run)");
+}
+
 std::uint64_t cycle_checked(World& w, std::uint64_t n) {
   std::uint64_t done;
   {
     RunningWorld running(w);
     done = w.cycle(n);
   }
-  if (take_run_interrupt() || done < n)
-    throw Interrupted("interrupted at step " + std::to_string(w.step_count()) +
-                      " (the world is intact: continue with world:cycle or world:run)");
+  if (take_run_interrupt() || done < n) throw_interrupted(w);
   return done;
 }
 
@@ -991,65 +994,51 @@ int world_run(lua_State* L) {
     if (steps == 0 && stop_type == LUA_TNIL)
       throw Error(ctx + ": give steps = (how many) and/or stop_when = (a function or \"equilibrium\")");
 
-    const std::uint64_t limit =
-        steps > 0 ? static_cast<std::uint64_t>(steps) : std::numeric_limits<std::uint64_t>::max();
-    const bool checks = stop_type != LUA_TNIL || callback_type != LUA_TNIL;
-    const auto K = static_cast<std::uint64_t>(every);
-    Progress bar(progress, steps > 0 ? static_cast<std::uint64_t>(steps) : 0);
-    std::uint64_t done = 0, chunk = 1;
-    double last_ratio = NAN;
-    const char* reason = "steps";
-    using Clock = std::chrono::steady_clock;
-    while (done < limit) {
-      // Chunks sized to take ~50 ms so the progress line and Ctrl-C stay responsive without a
-      // measurable per-call cost, and cut at every K-th step where the checks run.
-      std::uint64_t n = std::min(chunk, limit - done);
-      if (checks) n = std::min(n, K - done % K);
-      auto t0 = Clock::now();
-      done += cycle_checked(w, n);
-      double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-      if (seconds < 0.02 && chunk < (1u << 20)) chunk *= 2;
-      else if (seconds > 0.1 && chunk > 1) chunk /= 2;
-      if (checks && done % K == 0) {
-        if (callback_type != LUA_TNIL) call_with_world(L, callback, 0);
-        if (equilibrium) {
-          last_ratio = w.unbalanced_force_ratio();
-          if (last_ratio <= ratio) {
-            reason = "equilibrium";
-            break;
-          }
-        } else if (stop_type == LUA_TFUNCTION) {
-          call_with_world(L, stop_fn, 1);
-          bool stop = lua_toboolean(L, -1);
-          lua_pop(L, 1);
-          if (stop) {
-            reason = "stop_when";
-            break;
-          }
-        }
+    RunPlan plan;
+    plan.steps = static_cast<std::uint64_t>(steps);
+    plan.until_equilibrium = equilibrium;
+    plan.ratio = ratio;
+    plan.every = static_cast<std::uint64_t>(every);
+    if (callback_type != LUA_TNIL) plan.callback = [&] { call_with_world(L, callback, 0); };
+    if (stop_type == LUA_TFUNCTION)
+      plan.stop_when = [&] {
+        call_with_world(L, stop_fn, 1);
+        const bool stop = lua_toboolean(L, -1);
+        lua_pop(L, 1);
+        return stop;
+      };
+    plan.interrupted = take_run_interrupt;
+    Progress bar(progress, plan.steps);
+    plan.on_chunk = [&](std::uint64_t done, double last_ratio) {
+      if (!bar.due()) return;
+      std::string extra;
+      if (equilibrium && !std::isnan(last_ratio)) {
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "ratio=%.3g (target %.3g)", last_ratio, ratio);
+        extra = buf;
       }
-      if (bar.due()) {
-        std::string extra;
-        if (equilibrium && !std::isnan(last_ratio)) {
-          char buf[64];
-          std::snprintf(buf, sizeof buf, "ratio=%.3g (target %.3g)", last_ratio, ratio);
-          extra = buf;
-        }
-        if (show_type != LUA_TNIL) {
-          std::string s = show_text(L, show);
-          if (!s.empty()) extra += (extra.empty() ? "" : "  ") + s;
-        }
-        double fraction = -1;
-        if (fraction_type != LUA_TNIL) {
-          call_with_world(L, fraction_fn, 1);
-          fraction = lua_isnumber(L, -1) ? std::max(0.0, static_cast<double>(lua_tonumber(L, -1))) : -1;
-          lua_pop(L, 1);
-        }
-        bar.draw(done, extra, fraction);
+      if (show_type != LUA_TNIL) {
+        std::string text = show_text(L, show);
+        if (!text.empty()) extra += (extra.empty() ? "" : "  ") + text;
       }
+      double fraction = -1;
+      if (fraction_type != LUA_TNIL) {
+        call_with_world(L, fraction_fn, 1);
+        fraction = lua_isnumber(L, -1) ? std::max(0.0, static_cast<double>(lua_tonumber(L, -1))) : -1;
+        lua_pop(L, 1);
+      }
+      bar.draw(done, extra, fraction);
+    };
+    RunResult r;
+    {
+      RunningWorld running(w);  // a Ctrl-C stops the engine's step (interrupt.hpp)
+      r = w.run(plan);
     }
-    bar.finish(done, reason);
-    lua_pushinteger(L, static_cast<lua_Integer>(done));
+    if (r.end == RunResult::End::interrupted) throw_interrupted(w);
+    static const char* const reasons[] = {"steps", "equilibrium", "stop_when"};
+    const char* reason = reasons[static_cast<int>(r.end)];
+    bar.finish(r.steps, reason);
+    lua_pushinteger(L, static_cast<lua_Integer>(r.steps));
     lua_pushstring(L, reason);
     return 2;
   });

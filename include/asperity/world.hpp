@@ -10,6 +10,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <span>
@@ -272,6 +273,29 @@ struct StepStats {
                                    // only; -1: not measured), which the automatic count leaves
 };
 
+// A run of many steps with stop conditions (World::run).
+struct RunPlan {
+  std::uint64_t steps = 0;         // at most this many; 0: no limit (a stop condition is needed)
+  bool until_equilibrium = false;  // stop once unbalanced_force_ratio() <= ratio
+  double ratio = 1e-4;
+  std::uint64_t every = 100;       // steps between checks: the callback, then the stop condition
+  std::function<void()> callback;
+  std::function<bool()> stop_when;  // true ends the run
+  // An outside request to stop, polled after every chunk of steps (e.g. a Ctrl-C that landed
+  // between two chunks); request_stop() ends a chunk early, which also ends the run.
+  std::function<bool()> interrupted;
+  // After every chunk (chunks are sized to take about 50 ms, cut at the checks): the steps done
+  // and the last equilibrium ratio (NaN before the first check). For progress reports.
+  std::function<void(std::uint64_t steps, double ratio)> on_chunk;
+};
+
+struct RunResult {
+  enum class End { steps, equilibrium, stop_when, interrupted };
+  std::uint64_t steps = 0;
+  End end = End::steps;
+  double ratio = std::numeric_limits<double>::quiet_NaN();  // the last equilibrium check's
+};
+
 class World {
  public:
   explicit World(WorldSettings settings = {});
@@ -395,6 +419,9 @@ class World {
   // Advance n steps. Returns the number of steps done: fewer than n only if request_stop() was
   // called (e.g. from a SIGINT handler). Throws HealthError when the run goes wrong.
   std::uint64_t cycle(std::uint64_t n);
+  // Steps until the plan's limit or stop condition, or an interruption. The hooks may throw: the
+  // run then ends where it was, the world intact. A stop request ends only the run it reaches.
+  RunResult run(const RunPlan& plan);
   void request_stop();                    // async-signal-safe
   double dt() const;                      // the step in use
   void set_dt(double dt);                 // fix it (0: back to automatic)
