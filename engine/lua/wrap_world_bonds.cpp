@@ -1,0 +1,220 @@
+// world: bonds (install, strength, list, break events) and checkpoints (save, asperity.load).
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "asperity/world.hpp"
+#include "lua/binding.hpp"
+#include "lua/wrap_world.hpp"
+
+namespace asperity::lua {
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Bonds
+
+const char* break_mode_name(BreakEvent::Mode m) {
+  switch (m) {
+    case BreakEvent::Mode::tension: return "tension";
+    case BreakEvent::Mode::compression: return "compression";
+    case BreakEvent::Mode::shear: return "shear";
+  }
+  return "?";
+}
+
+int world_install_bonds(lua_State* L) {
+  return guarded(L, [&] {
+    World& w = world_arg(L);
+    const std::string ctx = "world:install_bonds";
+    Options o(L, 2, ctx, 2);
+    BondMaterial m;
+    // Defaults of the Lua layer: the beam as stiff as the world's contact springs (model.md 5:
+    // kbn A = kn, kbs = kbn / 10), not the C++ struct's constants.
+    m.beam_kn = o.number("beam_kn", w.settings().contact.kn);
+    m.beam_ks = o.number("beam_ks", m.beam_kn / 10);
+    m.radius_factor = o.number("radius_factor", m.radius_factor);
+    m.breakable = o.boolean("breakable", true);
+    auto st = o.number("tensile_strength");
+    double tolerance = o.number("tolerance", -1);
+    const bool stress_free = o.boolean("stress_free", false);
+    std::vector<std::int64_t> ids;
+    if (o.push("ids") != LUA_TNIL) ids = ids_arg(L, lua_gettop(L), w, ctx.c_str());
+    lua_pop(L, 1);
+    o.finish();
+    if (m.breakable && !st)
+      throw Error(ctx + ": give tensile_strength = (Pa), or breakable = false for elastic bonds");
+    if (st) m.tensile_strength = *st;
+    lua_pushinteger(L, static_cast<lua_Integer>(w.install_bonds(m, tolerance, ids, stress_free)));
+    return 1;
+  });
+}
+
+// Checkpoints: world:save(path), asperity.load(path [, {threads=, simd=}]).
+int world_save(lua_State* L) {
+  return guarded(L, [&] {
+    World& w = world_arg(L);
+    const std::string path = check_string(L, 2);
+    w.save(path);
+    return 0;
+  });
+}
+
+int world_set_bond_strength(lua_State* L) {
+  return guarded(L, [&] {
+    World& w = world_arg(L);
+    Options o(L, 2, "world:set_bond_strength", 2);
+    const bool breakable = o.boolean("breakable", true);
+    const auto st = o.number("tensile_strength");
+    o.finish();
+    if (breakable && !st)
+      throw Error("world:set_bond_strength: give tensile_strength = (Pa), or breakable = false");
+    w.set_bond_strength(st ? *st : 0.0, breakable);
+    return 0;
+  });
+}
+
+int world_remove_bonds(lua_State* L) {
+  return guarded(L, [&] {
+    world_arg(L).remove_bonds();
+    return 0;
+  });
+}
+
+int world_bond_count(lua_State* L) {
+  return guarded(L, [&] {
+    lua_pushinteger(L, static_cast<lua_Integer>(world_arg(L).bond_count()));
+    return 1;
+  });
+}
+
+int world_bonds(lua_State* L) {
+  return guarded(L, [&] {
+    std::vector<BondInfo> bs = world_arg(L).bonds();
+    lua_createtable(L, static_cast<int>(bs.size()), 0);
+    for (std::size_t k = 0; k < bs.size(); ++k) {
+      const BondInfo& b = bs[k];
+      lua_createtable(L, 0, 12);
+      auto num = [&](const char* f, double v) { lua_pushnumber(L, v); lua_setfield(L, -2, f); };
+      auto vec = [&](const char* f, const Vec3& v) { push_vec(L, v); lua_setfield(L, -2, f); };
+      lua_pushinteger(L, b.id_a + 1);
+      lua_setfield(L, -2, "a");
+      lua_pushinteger(L, b.id_b + 1);
+      lua_setfield(L, -2, "b");
+      vec("normal", b.normal);
+      vec("point", b.point);
+      num("gap", b.gap);
+      num("beam_radius", b.beam_radius);
+      num("normal_force", b.normal_force);
+      vec("shear_force", b.shear_force);
+      num("twisting_moment", b.twisting_moment);
+      vec("bending_moment", b.bending_moment);
+      num("sigma", b.sigma);
+      num("tau", b.tau);
+      lua_rawseti(L, -2, static_cast<lua_Integer>(k + 1));
+    }
+    return 1;
+  });
+}
+
+int world_break_events(lua_State* L) {
+  return guarded(L, [&] {
+    World& w = world_arg(L);
+    const std::vector<BreakEvent>& events = w.break_events();
+    lua_Integer first = opt_integer(L, 2, 1);
+    if (first < 1) throw ArgError{2, "events are numbered from 1"};
+    lua_createtable(L, 0, 0);
+    lua_Integer k = 0;
+    for (std::size_t i = static_cast<std::size_t>(first - 1); i < events.size(); ++i) {
+      const BreakEvent& e = events[i];
+      lua_createtable(L, 0, 9);
+      lua_pushinteger(L, static_cast<lua_Integer>(e.step));
+      lua_setfield(L, -2, "step");
+      lua_pushnumber(L, e.time);
+      lua_setfield(L, -2, "time");
+      push_vec(L, e.position);
+      lua_setfield(L, -2, "position");
+      lua_pushinteger(L, e.id_a + 1);
+      lua_setfield(L, -2, "a");
+      lua_pushinteger(L, e.id_b + 1);
+      lua_setfield(L, -2, "b");
+      lua_pushstring(L, break_mode_name(e.mode));
+      lua_setfield(L, -2, "mode");
+      lua_pushnumber(L, e.sigma);
+      lua_setfield(L, -2, "sigma");
+      lua_pushnumber(L, e.tau);
+      lua_setfield(L, -2, "tau");
+      lua_pushnumber(L, e.released_energy);
+      lua_setfield(L, -2, "released_energy");
+      lua_rawseti(L, -2, ++k);
+    }
+    return 1;
+  });
+}
+
+int world_break_count(lua_State* L) {
+  return guarded(L, [&] {
+    lua_pushinteger(L, static_cast<lua_Integer>(world_arg(L).break_events().size()));
+    return 1;
+  });
+}
+
+}  // namespace
+
+int load_world(lua_State* L) {
+  return guarded(L, [&] {
+    const std::string path = check_string(L, 1);
+    int threads = 0;
+    std::string simd = "auto";
+    if (!lua_isnoneornil(L, 2)) {
+      Options o(L, 2, "asperity.load", 2);
+      threads = int_in(o.integer("threads", threads), "asperity.load: threads", 0, kMaxThreads);
+      simd = o.string("simd", simd);
+      o.finish();
+    }
+    World loaded = World::load(path, threads, simd);
+    void* mem = lua_newuserdatauv(L, sizeof(World), 0);
+    new (mem) World(std::move(loaded));
+    luaL_setmetatable(L, kWorldType);
+    return 1;
+  });
+}
+
+int bond_criterion(lua_State* L) {
+  return guarded(L, [&] {
+    double sigma = check_number(L, 1), tau = check_number(L, 2), st = check_number(L, 3);
+    lua_pushnumber(L, World::bond_criterion(sigma, tau, st));
+    return 1;
+  });
+}
+
+std::span<const Function> world_bond_methods() {
+  static const Function methods[] = {
+      {"install_bonds", world_install_bonds,
+       "world:install_bonds{tensile_strength= | breakable=false [, beam_kn=] [, beam_ks=]\n"
+       "  [, radius_factor=] [, tolerance=] [, ids=] [, stress_free=false]} -> count",
+       "Bonds (contact + parallel bond, model.md 5) between every pair closer than tolerance\n"
+       "(default 1e-3 mean radius); beam_kn defaults to the world's kn, beam_ks to beam_kn/10;\n"
+       "ids (a list or predicate) restricts them to pairs of those particles. Existing contact\n"
+       "forces are kept; stress_free = true unloads each contact bond at its current overlap\n"
+       "instead (a contact left by a break keeps that rest overlap until the pair separates)."},
+      {"bond_count", world_bond_count, "world:bond_count() -> n", "Intact bonds."},
+      {"set_bond_strength", world_set_bond_strength,
+       "world:set_bond_strength{tensile_strength= | breakable=false}",
+       "Changes the strength of every bond (stiffness and stored forces unchanged)."},
+      {"remove_bonds", world_remove_bonds, "world:remove_bonds()",
+       "Deletes every bond (no break events; bonded pairs become ordinary contacts)."},
+      {"save", world_save, "world:save(path)",
+       "Writes a checkpoint (the whole state, HDF5); asperity.load(path) continues bit for bit."},
+      {"bonds", world_bonds, "world:bonds() -> {bond, ...}",
+       "Intact bonds: {a, b, normal, point, gap, beam_radius, normal_force, shear_force,\n"
+       "twisting_moment, bending_moment, sigma, tau}."},
+      {"break_events", world_break_events, "world:break_events([first]) -> {event, ...}",
+       "Bond breaks so far (from number `first`): {step, time, position, a, b, mode, sigma, tau,\n"
+       "released_energy}; mode is \"tension\", \"compression\" or \"shear\"."},
+      {"break_count", world_break_count, "world:break_count() -> n", "Bond breaks so far."},
+  };
+  return methods;
+}
+
+}  // namespace asperity::lua
