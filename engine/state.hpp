@@ -239,10 +239,7 @@ void for_each_bond(const State& s, F&& f) {
     for (std::size_t k = 0; k < q->n; ++k) f(*q, k);
 }
 
-void compute_pair_forces(State& s);     // kernels/pairs.cpp
 kernels::PairKernelArgs pair_kernel_args(State& s);  // its kernel's arguments (perf/ reuses them)
-void compute_wall_forces(State& s);     // kernels/walls.cpp
-void compute_bond_forces(State& s);     // kernels/bonds.cpp
 kernels::BondKernelArgs bond_kernel_args(State& s);  // its kernel's arguments (perf/ reuses them)
 void process_breaks(State& s);          // kernels/bonds.cpp: events, energy, compaction
 void refresh_bond_topology(State& s);   // kernels/bonds.cpp: incidence, partners, rotation locks
@@ -257,7 +254,6 @@ BondStore merge_bonds(const BondStore& x, const BondStore& y);
 // CSR of the pairs (a, b) per particle, entries (k << 1) | (particle is b), ascending k.
 void build_incidence(std::size_t particles, const std::int64_t* a, const std::int64_t* b,
                      std::size_t count, Incidence& inc);
-void gather_and_integrate(State& s);    // kernels/integrate.cpp
 // neighbor/build.cpp: pair k of q (a and b set) as the search starts a new one: the current
 // direction as its previous normal, no shear or normal force, no rest overlap. Returns the
 // centres' distance.

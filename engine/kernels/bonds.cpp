@@ -226,11 +226,6 @@ StageLoop bond_stage(State& s) {
   return st;  // no finish: the breaks are processed after the step (process_breaks)
 }
 
-void compute_bond_forces(State& s) {
-  StageLoop st = bond_stage(s);
-  run_stages(s, {&st});
-}
-
 void process_breaks(State& s) {
   BondStore& q = s.bonds;
   double any = 0;

@@ -198,9 +198,4 @@ StageLoop integrate_stage(State& s) {
   return st;
 }
 
-void gather_and_integrate(State& s) {
-  StageLoop st = integrate_stage(s);
-  run_stages(s, {&st});
-}
-
 }  // namespace asperity::detail

@@ -184,11 +184,7 @@ struct KernelSet {
 };
 
 const KernelSet& scalar_kernels();
-// The contact and bond laws in single precision (geometry, history and integration in double):
-// scalar, for issue 7's run-time-against-error study (kernels/float_study.cpp). Selected by the
-// name "float"; not among the architectures the SIMD tests compare bit for bit.
-const KernelSet& float_study_kernels();
-// The kernel set for `name` ("auto": the best the CPU supports; "float": float_study_kernels).
+// The kernel set for `name` ("auto": the best the CPU supports).
 // Throws asperity::Error for an unknown or unsupported name, listing the valid ones.
 const KernelSet& select_kernels(const std::string& name);
 

@@ -124,9 +124,4 @@ StageLoop pair_stage(State& s) {
   return st;
 }
 
-void compute_pair_forces(State& s) {
-  StageLoop st = pair_stage(s);
-  run_stages(s, {&st});
-}
-
 }  // namespace asperity::detail

@@ -387,9 +387,4 @@ StageLoop wall_stage(State& s) {
   return st;
 }
 
-void compute_wall_forces(State& s) {
-  StageLoop st = wall_stage(s);
-  run_stages(s, {&st});
-}
-
 }  // namespace asperity::detail
