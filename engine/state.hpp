@@ -287,15 +287,6 @@ void update_servo_stiffness(State& s);  // bodies/groups.cpp: every step while a
 void sync_lazy(State& s);               // bodies/groups.cpp: bring inert and idle members up to date
 void split_idle(State& s);              // bodies/groups.cpp: busy / idle members of lazy groups
 
-// Geometry helpers shared by the wall kernel and the neighbour search (kernels/walls.cpp).
-// Closest point on triangle (a, b, c) to p; `feature`: 0 face, 1..3 vertex a, b, c, 4..6 edge ab,
-// bc, ca.
-Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
-                               int& feature);
-void bin_mesh(Mesh& mesh);
-// Candidate triangles of `mesh` within `reach` of the point `q` (mesh coordinates), sorted.
-void query_mesh(const Mesh& mesh, const Vec3& q, double reach, std::vector<std::int32_t>& out);
-
 // Threads for a parallel stage. Automatic (settings.threads == 0): one per 10 000 units of
 // force work, a pair counting one and a bond two (its kernel and gather cost about twice a
 // pair's), or one per 20 000 particles if that is more (before the first pair list), up to the

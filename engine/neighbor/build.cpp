@@ -33,6 +33,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "bodies/mesh.hpp"
 #include "state.hpp"
 
 namespace asperity::detail {
