@@ -119,9 +119,9 @@ struct GatherArgs {
   const std::uint8_t* inert; const std::uint8_t* idle;
   double* fx; double* fy; double* fz;
   double* tx; double* ty; double* tz;
-  // Prefetch the records of the particle eight ahead (vector gathers only): for record arrays
-  // past the caches, whose lines the incidences reach out of order (kernels/integrate.cpp,
-  // records_past_caches in state.hpp; perf/README.md).
+  // Prefetch the records of the particle kGatherAhead ahead (vector gathers only, gather_loop.hpp):
+  // for record arrays past the caches, whose lines the incidences reach out of order
+  // (kernels/integrate.cpp, records_past_caches in state.hpp).
   bool prefetch = false;
   // Pair lists: per pair, 0 where its record is zero but for the overlap (PairKernelArgs::live,
   // from this step's pair kernel); the gather skips those records.

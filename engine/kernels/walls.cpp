@@ -1,8 +1,8 @@
 // Stage `walls`: ball-wall contacts (planes and triangle meshes) with the same contact law as
 // ball-ball pairs (model.md 4), the wall in the role of body a: it translates with its prescribed
-// velocity and does not spin. Plane contacts run through the SIMD plane kernel
-// (kernels/wall_loop.hpp; scalar they took 15 % of the in-cache lattice step, perf/README.md),
-// mesh contacts here, scalar: their geometry branches per triangle feature (bodies/mesh.hpp).
+// velocity and does not spin. Plane contacts, as many as the particles along a box's faces and
+// the same arithmetic for each, run through the SIMD plane kernel (kernels/wall_loop.hpp); mesh
+// contacts here, scalar: their geometry branches per triangle feature (bodies/mesh.hpp).
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -96,8 +96,9 @@ bool mesh_feature_contact_is_real(const Mesh& mesh, int t, int feature, const Ve
 }
 }  // namespace
 
-// Candidates ahead of the one evaluated whose mesh data the wall stage prefetches: 32 on the
-// AVX-512 Zen 5 (thesis-scale packing 0.930 of the step time with prefetches; 16: 0.946, 64: 0.970).
+// Candidates ahead of the one evaluated whose mesh data the wall stage prefetches (meshes past the
+// caches, Mesh::past_caches): far enough ahead that the lines arrive before they are read, near
+// enough that they are not evicted again first; the distance is a trial's best, not derived.
 constexpr std::size_t kWallAhead = 32;
 
 StageLoop wall_stage(State& s) {
