@@ -239,10 +239,7 @@ void for_each_bond(const State& s, F&& f) {
     for (std::size_t k = 0; k < q->n; ++k) f(*q, k);
 }
 
-void compute_pair_forces(State& s);     // kernels/pairs.cpp
 kernels::PairKernelArgs pair_kernel_args(State& s);  // its kernel's arguments (perf/ reuses them)
-void compute_wall_forces(State& s);     // kernels/walls.cpp
-void compute_bond_forces(State& s);     // kernels/bonds.cpp
 kernels::BondKernelArgs bond_kernel_args(State& s);  // its kernel's arguments (perf/ reuses them)
 void process_breaks(State& s);          // kernels/bonds.cpp: events, energy, compaction
 void refresh_bond_topology(State& s);   // kernels/bonds.cpp: incidence, partners, rotation locks
@@ -257,7 +254,6 @@ BondStore merge_bonds(const BondStore& x, const BondStore& y);
 // CSR of the pairs (a, b) per particle, entries (k << 1) | (particle is b), ascending k.
 void build_incidence(std::size_t particles, const std::int64_t* a, const std::int64_t* b,
                      std::size_t count, Incidence& inc);
-void gather_and_integrate(State& s);    // kernels/integrate.cpp
 // neighbor/build.cpp: pair k of q (a and b set) as the search starts a new one: the current
 // direction as its previous normal, no shear or normal force, no rest overlap. Returns the
 // centres' distance.
@@ -290,15 +286,6 @@ void watch_load(State& s);              // step.cpp: State::load_limit, for auto
 void update_servo_stiffness(State& s);  // bodies/groups.cpp: every step while a servo acts
 void sync_lazy(State& s);               // bodies/groups.cpp: bring inert and idle members up to date
 void split_idle(State& s);              // bodies/groups.cpp: busy / idle members of lazy groups
-
-// Geometry helpers shared by the wall kernel and the neighbour search (kernels/walls.cpp).
-// Closest point on triangle (a, b, c) to p; `feature`: 0 face, 1..3 vertex a, b, c, 4..6 edge ab,
-// bc, ca.
-Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
-                               int& feature);
-void bin_mesh(Mesh& mesh);
-// Candidate triangles of `mesh` within `reach` of the point `q` (mesh coordinates), sorted.
-void query_mesh(const Mesh& mesh, const Vec3& q, double reach, std::vector<std::int32_t>& out);
 
 // Threads for a parallel stage. Automatic (settings.threads == 0): one per 10 000 units of
 // force work, a pair counting one and a bond two (its kernel and gather cost about twice a

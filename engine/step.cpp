@@ -369,14 +369,14 @@ void run_stages_serially(std::initializer_list<StageLoop*> stages) {
 void run_stages(State& s, std::initializer_list<StageLoop*> stages) {
   // Every block writes only its own slots and `finish` sums them in block order, so which thread
   // runs a block changes no result; the split only decides the speed. Each thread owns the same
-  // contiguous share of every stage's blocks in every step (a block's data stays in that core's
-  // cache: handing blocks out dynamically made the joint 2x slower, perf/README.md), runs it from
-  // the front, and then takes what is left of the other shares from their backs: a thread that
-  // a busy core or a costlier share holds back is helped by its last blocks, not made to wait
-  // for at a barrier. The force stages do not wait for each other (they read the particles and
+  // contiguous share of every stage's blocks in every step (so a block's data, its pairs'
+  // history among it, stays in that core's cache from step to step), runs it from the front,
+  // and then takes what is left of the other shares from their backs: a thread that a busy core
+  // or a costlier share holds back is helped by its last blocks, not made to wait for at a
+  // barrier. The force stages do not wait for each other (they read the particles and
   // write their own lists only); a stage after_barrier does.
   const int threads = thread_count(s);
-  if (threads == 1) {  // no parallel region (a fork costs ~1.3 us, a tenth of a rigid joint's step)
+  if (threads == 1) {  // no parallel region: on one thread its fork and barriers are pure cost
     run_stages_serially(stages);
     return;
   }
@@ -440,10 +440,9 @@ void step_once(State& s) {
     run_stages(s, {&pairs, &bonds, &walls, &particles});
     s.kinetic_at_step = 0;  // the particles' share is added in bookkeeping
   } else {
-    // The rigid groups in the same region: on two threads the elastic joint's 1132 platen
-    // members were ~15 % of its step, run by one thread while the other waited. Their two more
-    // barriers cost more than they save where few members move (the rigid joint's ~200: 1.15x
-    // slower), so those run after the region as before (perf/README.md).
+    // The rigid groups in the same region where many members move (a platen of the elastic
+    // joint), so that no thread waits while another moves them. Where few move, their two more
+    // barriers would cost more than they save, so those stages run after the region.
     GroupStages g = group_stages(s);
     if (s.moved_particle.size() >= kParallelMoves) {
       run_stages(s, {&pairs, &bonds, &walls, &particles, &g.servo, &g.motion, &g.moves});

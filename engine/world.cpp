@@ -11,6 +11,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "bodies/mesh.hpp"
 #include "kernels/bond_law.hpp"
 #include "state.hpp"
 

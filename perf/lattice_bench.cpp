@@ -49,6 +49,13 @@ std::pair<double, double> time_per_call(F&& f, int calls) {
   return {seconds_since(t0) / calls, (cpu_seconds() - c0) / calls};
 }
 
+// One stage on its own, run as the step runs its stages (run_stages).
+void run_stage(asperity::detail::State& s,
+               asperity::detail::StageLoop (*stage)(asperity::detail::State&)) {
+  asperity::detail::StageLoop st = stage(s);
+  asperity::detail::run_stages(s, {&st});
+}
+
 [[noreturn]] void usage(const char* bad) {
   std::fprintf(stderr,
                "lattice_bench: bad argument '%s'\nusage: lattice_bench [n=40] [steps=1000] "
@@ -131,9 +138,9 @@ int main(int argc, char** argv) {
         sum[k] += cpu ? ct : wall;
       };
       add(0, [&] { w.cycle(1); });
-      add(1, [&] { compute_pair_forces(s); });
-      add(2, [&] { compute_wall_forces(s); });
-      add(3, [&] { gather_and_integrate(s); });
+      add(1, [&] { run_stage(s, pair_stage); });
+      add(2, [&] { run_stage(s, wall_stage); });
+      add(3, [&] { run_stage(s, integrate_stage); });
     }
     const double t_step = sum[0] / calls, t_pair = sum[1] / calls, t_wall = sum[2] / calls,
                  t_gi = sum[3] / calls;

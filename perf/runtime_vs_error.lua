@@ -62,7 +62,6 @@ local scenes = {
       {"skin_4", "skin 2e-4 m (0.4 mean radius, the default before 2026-11-26)", {skin = 2e-4}},
       {"record_x0.5", "records every 0.005 mm", {record = rec / 2}},
       {"record_x5", "records every 0.05 mm", {record = 5 * rec}},
-      {"float", "force laws in single precision (scalar study kernels: error, not speed)", {simd = "float"}},
       -- Stress settings: where results degrade, and whether the engine says so.
       {"stress_velocity_x10", "velocity x 10", {velocity = 10 * v}},
       {"stress_dt_1.3", "dt 1.3 x estimate", {dt_safety = 1.3}},
@@ -95,7 +94,6 @@ local scenes = {
       {"dt_1.0", "dt 1.0 x estimate", {dt_safety = 1.0}},
       {"record_x0.5", "records every 50 steps", {every = math.floor(P.every / 2)}},
       {"record_x5", "records every 500 steps", {every = 5 * P.every}},
-      {"float", "force laws in single precision (scalar study kernels: error, not speed)", {simd = "float"}},
       {"stress_rate_x10", "rate x 10", {rate = 10 * P.rate}},
       {"stress_dt_1.3", "dt 1.3 x estimate", {dt_safety = 1.3}},
     },

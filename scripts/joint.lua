@@ -97,7 +97,7 @@ local P = params_lib.parse{
   {"out", "out/joint", nonempty = true, doc = "output folder (created when the run starts writing)"},
   {"cache", "", doc = "folder of cached specimens (\"\": $ASPERITY_CACHE, else ~/.cache/asperity, else out/cache)"},
   {"threads", 0, type = "integer", min = 0, doc = "0: automatic"},
-  {"simd", "auto", oneof = {"auto", "float", "scalar", "sse4_2", "avx2", "avx512f"},
+  {"simd", "auto", oneof = {"auto", "scalar", "sse4_2", "avx2", "avx512f"},
    doc = "kernels of closure and shear; float: the force laws in single precision"},
   {"progress", true, doc = "progress line on the terminal"},
   {"events_every", 0, type = "integer", min = 0,

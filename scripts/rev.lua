@@ -82,7 +82,7 @@ local P = params_lib.parse{
   {"dt_safety", 0, min = 0, max = 2, doc = "time step / critical estimate in the tests (0: the engine's 0.8; above 1 only to study instability)"},
   {"cache", "", doc = "a folder: the packing is cached there and reused (calibrate_rev.lua)"},
   {"threads", 1, type = "integer", min = 0, doc = "0: automatic"},
-  {"simd", "auto", oneof = {"auto", "float", "scalar", "sse4_2", "avx2", "avx512f"},
+  {"simd", "auto", oneof = {"auto", "scalar", "sse4_2", "avx2", "avx512f"},
    doc = "kernels of bonding and tests; float: the force laws in single precision"},
   {"out", "out/rev", nonempty = true, doc = "output folder"},
   check = function(P, fail)

@@ -241,8 +241,8 @@ GroupStages group_stages(State& s) {
 }
 
 // The servo gain G = relaxation / (K dt) needs the stiffness K the group meets now: computed every
-// step from this step's overlaps (a stale K, e.g. from before the platen touched, turned the servo
-// into a bang-bang controller that rang between 28 % and 102 % of the target and created energy).
+// step from this step's overlaps (a stale K, e.g. from before the platen touched, makes the servo a
+// bang-bang controller that rings about the target and creates energy).
 // Only the pairs joining two bodies can contribute; their indices are collected once per rebuild.
 void update_servo_stiffness(State& s) {
   if (s.groups.empty()) return;

@@ -1,14 +1,13 @@
 // Large arrays on transparent huge pages (aligned.hpp, AlignedAllocator).
 //
-// Why: the columns of a scene past the caches (the lattice n = 40 holds ~40 MB in some forty
-// columns) are walked by many streams at once, each on its own 4 kB pages; with 2 MB pages the
-// page walks go. Measured in one process (perf/ab.sh, lattice, AVX2 machine of perf/README.md):
-// 0.90-0.92 of the step time at n = 40, 0.95 at n = 100 (1e6 particles), 0.93-0.96 on two threads.
+// Why: the columns of a scene past the caches (some forty of them) are walked by many streams at
+// once, each on its own 4 kB pages, and the TLB cannot hold them all; with 2 MB pages the page
+// walks go.
 //
 // Why the stagger: arrays that all start on a 2 MB boundary put element i of every column in the
-// same L1 and L2 sets, and the pair kernel reads some twenty columns at one index: that was
-// slower than 4 kB pages (1.09). Starting each array at a different 64-byte line within its
-// first 4 kB spreads them over the sets again.
+// same L1 and L2 sets, and the pair kernel reads some twenty columns at one index, more than a
+// set holds, so they would evict one another (slower than on 4 kB pages). Starting each array at
+// a different 64-byte line within its first 4 kB spreads them over the sets again.
 #include "core/aligned.hpp"
 
 #include <atomic>

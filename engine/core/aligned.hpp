@@ -17,8 +17,8 @@ inline std::size_t round_up(std::size_t n, std::size_t m) { return (n + m - 1) /
 
 namespace detail_memory {
 // Arrays of at least this many bytes are mapped on their own, on transparent huge pages where
-// the system offers them, each starting at a different cache line (core/aligned.cpp: why, and
-// what it measured). Smaller ones come from the heap.
+// the system offers them, each starting at a different cache line (core/aligned.cpp says why).
+// Smaller ones come from the heap.
 inline constexpr std::size_t kLargeArray = std::size_t(256) << 10;
 void* allocate_large(std::size_t bytes);
 void release_large(void* p);

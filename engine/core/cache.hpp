@@ -1,8 +1,8 @@
 // The size of the last-level cache this process's first CPU sees, for choices that depend on
 // whether a working set fits (kernels/pairs.cpp: non-temporal record stores). Read once from
 // /sys/devices/system/cpu/cpu0/cache (the highest level listed); 32 MB where it cannot be read.
-// Not sysconf(_SC_LEVEL3_CACHE_SIZE): in a virtual machine it can report the host's total
-// (384 MB on the Zen 5 of perf/README.md, whose guest sees one 32 MB L3).
+// Not sysconf(_SC_LEVEL3_CACHE_SIZE): in a virtual machine it can report the host's total over
+// all its L3s instead of the one the guest sees.
 #pragma once
 #include <cstddef>
 #include <string_view>

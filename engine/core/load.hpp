@@ -1,11 +1,11 @@
 // The cores other processes leave free, for the automatic thread count (WorldSettings::threads
 // = 0). A step is split over threads that meet at barriers, so a thread sharing its core with
-// another busy process holds every other thread up: on the two-core machine of perf/README.md a
-// process spinning on one core made the default joint's step 2.2x slower on two threads than on
-// one ("Threads on a busy machine"). The watcher compares the busy time of the CPUs this process
-// may run on (/proc/stat) with the process's own CPU time (getrusage) over intervals of half a
-// second and gives the number of threads that the rest leaves room for. The thread count changes
-// no result (every stage sums in a fixed order), only the speed.
+// another busy process holds every other thread up at each barrier: on a machine with a core
+// busy elsewhere, more threads than free cores make a step slower than fewer would. The watcher
+// compares the busy time of the CPUs this process may run on (/proc/stat) with the process's own
+// CPU time (getrusage) over intervals of half a second and gives the number of threads that the
+// rest leaves room for. The thread count changes no result (every stage sums in a fixed order),
+// only the speed.
 #pragma once
 #include <atomic>
 #include <chrono>
@@ -36,8 +36,8 @@ double proc_stat_busy_seconds(std::string_view text, const std::vector<int>& cpu
 
 // Threads worth running on `cpus` CPUs while other processes keep `others` cores busy on average:
 // one per core they leave free, a core counting as free while they take less than 0.3 of it (a
-// thread that gets 70 % of a core still gains more than the barrier waits cost: "Threads on a
-// busy machine"). At least 1.
+// thread that gets the rest of such a core still gains more than its barrier waits cost). At
+// least 1.
 int free_threads(int cpus, double others);
 
 // One per process (process_load) for the worlds: a new world starts from what the last one saw.

@@ -16,6 +16,7 @@
 #include <type_traits>
 
 #include "asperity/io.hpp"
+#include "bodies/mesh.hpp"
 #include "io/hdf5_file.hpp"
 #include "state.hpp"
 

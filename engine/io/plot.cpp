@@ -1,9 +1,5 @@
-// PNG plots through gnuplot.
-//
-// gnuplot runs as a child process (posix_spawn, no shell, so no quoting of file names through
-// sh) on a script file and a data file written to a private temporary directory; its stderr is
-// captured into that directory and quoted in the error if it fails. The PNG is drawn to a
-// temporary name beside the target and renamed, like every other output file.
+// PNG plots through gnuplot: the runner every plot shares (io/plot.hpp says how it works) and
+// plot_png's curves.
 #include <spawn.h>
 #include <fcntl.h>
 #include <sys/wait.h>
@@ -17,6 +13,7 @@
 #include <sstream>
 
 #include "asperity/io.hpp"
+#include "io/plot.hpp"
 
 extern char** environ;
 
@@ -24,10 +21,7 @@ namespace asperity::io {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-// gnuplot single-quoted strings take a quote as two quotes and nothing else special.
-std::string quoted(const std::string& s) {
+std::string gnuplot_quoted(const std::string& s) {
   std::string q = "'";
   for (char c : s) {
     if (c == '\'') q += '\'';
@@ -36,22 +30,18 @@ std::string quoted(const std::string& s) {
   return q + "'";
 }
 
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "asperity-plot-XXXXXX").string();
-    if (!::mkdtemp(pattern.data())) throw Error(std::string("plot: mkdtemp: ") + std::strerror(errno));
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
+PlotDir::PlotDir() {
+  std::string pattern = (fs::temp_directory_path() / "asperity-plot-XXXXXX").string();
+  if (!::mkdtemp(pattern.data())) throw Error(std::string("plot: mkdtemp: ") + std::strerror(errno));
+  path_ = pattern;
+}
 
- private:
-  fs::path path_;
-};
+PlotDir::~PlotDir() {
+  std::error_code ec;
+  fs::remove_all(path_, ec);
+}
+
+namespace {
 
 // Runs `program args...`, stdout and stderr into `log`. Returns the exit status, -1 if it could
 // not be started.
@@ -84,8 +74,25 @@ std::string read_all(const fs::path& p) {
 
 }  // namespace
 
+void run_gnuplot(const PlotDir& dir, const std::string& script, AtomicFile& png) {
+  const fs::path script_file = dir.path() / "plot.gp";
+  {
+    std::ofstream out(script_file);
+    out << script;
+  }
+  const fs::path log = dir.path() / "gnuplot.log";
+  const int status = run_program({"gnuplot", script_file.string()}, log);
+  const std::string target = png.target().string();
+  if (status == -1)
+    throw Error("plot '" + target + "': cannot run gnuplot (install gnuplot-nox)");
+  if (status != 0 || !is_complete_png(png.temp_path()))
+    throw Error("plot '" + target + "': gnuplot failed (status " + std::to_string(status) +
+                "): " + read_all(log));
+  png.commit();
+}
+
 bool gnuplot_available() {
-  TempDir dir;
+  PlotDir dir;
   return run_program({"gnuplot", "--version"}, dir.path() / "log") == 0;
 }
 
@@ -97,7 +104,7 @@ void plot_png(const fs::path& path, const Column& x, std::span<const Column> ys,
       throw Error("plot '" + path.string() + "': column '" + y.name + "' has " +
                   std::to_string(y.values.size()) + " values but x ('" + x.name + "') has " +
                   std::to_string(x.values.size()));
-  TempDir dir;
+  PlotDir dir;
   fs::path data = dir.path() / "data.txt";
   {
     std::ofstream out(data);
@@ -133,35 +140,24 @@ void plot_png(const fs::path& path, const Column& x, std::span<const Column> ys,
   AtomicFile png(path);
   std::ostringstream gp;
   gp << "set terminal pngcairo noenhanced size " << options.width << "," << options.height
-     << "\nset output " << quoted(png.temp_path().string())
-     << "\nset xlabel " << quoted(options.xlabel.empty() ? x.label() : options.xlabel)
-     << "\nset ylabel " << quoted(ylabel) << "\nset grid\n";
+     << "\nset output " << gnuplot_quoted(png.temp_path().string())
+     << "\nset xlabel " << gnuplot_quoted(options.xlabel.empty() ? x.label() : options.xlabel)
+     << "\nset ylabel " << gnuplot_quoted(ylabel) << "\nset grid\n";
   // One curve needs no key (the axis label names it); several get theirs beside the plot, where
   // it never hides data.
   gp << (ys.size() == 1 ? "unset key\n" : "set key outside right top\n");
-  if (!options.title.empty()) gp << "set title " << quoted(options.title) << "\n";
+  if (!options.title.empty()) gp << "set title " << gnuplot_quoted(options.title) << "\n";
   if (options.logx) gp << "set logscale x\n";
   if (options.logy) gp << "set logscale y\nset format y \"%g\"\n";
   gp << "plot ";
   for (std::size_t j = 0; j < ys.size(); ++j) {
     if (j) gp << ", \\\n     ";
-    gp << quoted(data.string()) << " using 1:" << j + 2 << " with "
-       << (options.points ? "points" : "lines") << " linewidth 2 title " << quoted(ys[j].label());
+    gp << gnuplot_quoted(data.string()) << " using 1:" << j + 2 << " with "
+       << (options.points ? "points" : "lines") << " linewidth 2 title "
+       << gnuplot_quoted(ys[j].label());
   }
   gp << "\nunset output\n";
-  fs::path script = dir.path() / "plot.gp";
-  {
-    std::ofstream out(script);
-    out << gp.str();
-  }
-  fs::path log = dir.path() / "gnuplot.log";
-  int status = run_program({"gnuplot", script.string()}, log);
-  if (status == -1)
-    throw Error("plot '" + path.string() + "': cannot run gnuplot (install gnuplot-nox)");
-  if (status != 0 || !is_complete_png(png.temp_path()))
-    throw Error("plot '" + path.string() + "': gnuplot failed (status " + std::to_string(status) +
-                "): " + read_all(log));
-  png.commit();
+  run_gnuplot(dir, gp.str(), png);
 }
 
 }  // namespace asperity::io

@@ -1,9 +1,9 @@
 // The a-side particles of a batch of pairs or bonds. Both lists are sorted by a, and a particle
 // has a few pairs in a row, so the lanes' a usually lie within one lane-width window
 // [a0, a0 + lanes): then one contiguous load and a lane permutation replace each a-side gather
-// (ten of the twenty per batch with rotation; the gathers were most of the pair kernel's time on
-// the AMD EPYC of perf/README.md). The values loaded are the same, so the results are bitwise
-// those of the gathers.
+// (ten of the twenty per batch with rotation; a gather costs a load per lane, and the gathers are
+// most of what the pair kernel waits for). The values loaded are the same, so the results are
+// bitwise those of the gathers.
 #pragma once
 #include <cstddef>
 #include <cstdint>

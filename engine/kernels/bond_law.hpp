@@ -45,8 +45,8 @@ struct BondState {
 // Returns the criterion value (>= 1: broken); sigma and tau are returned too. U0: the contact
 // bond's rest overlap. Spin = false: both bodies have w = +0 (a bonded particle does not rotate,
 // model.md 5), and every term of w is left out: it would add or rotate by an exact +-0, so the
-// values are those of Spin = true except for the sign of an exact zero (carry_shear). The AVX2
-// loop then issues 105 multiplies and 86 adds per batch instead of 206 and 149 (perf/README.md).
+// values are those of Spin = true except for the sign of an exact zero (carry_shear), in about
+// half the multiplies and adds per batch.
 // Moments = false (only with Spin = false): the beam carries no moment, mbn = mbs = +-0 on entry;
 // without spin no increment reaches them and carrying a zero gives a zero, so they stay +-0 and
 // are neither carried nor read (the caller leaves their columns alone). Their terms of the

@@ -39,7 +39,7 @@ double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
     if (breakable) {
       // The flags stay 0 but where a bond breaks (process_breaks removes those; bond_stage clears
       // the column after a step whose breaks were not processed), so only such a batch stores:
-      // no column written at every step for nothing (perf/README.md, "What was tried").
+      // no column written at every step for nothing.
       const T brk = select(real & (crit >= T(1.0)), T(1.0), T(0.0));
       count = count + brk;
       if (any(brk != T(0.0))) Lanes::store(k.broken + i, brk);

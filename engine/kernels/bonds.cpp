@@ -185,8 +185,7 @@ StageLoop bond_stage(State& s) {
   // Then the kernel that takes w = +0 without reading it gives the same values (-0 counts as
   // spinning: its sign could reach a result; the law without spin differs from the full one at
   // w = +0 only in the sign of an exact zero, bond_law.hpp). It skips six loads and every spin
-  // term of the law: the joint's elastic step on one thread costs 6-18 % less for the loads and
-  // another 6-22 % for the terms; on two threads the latter did not show (perf/README.md).
+  // term of the law, which a bonded specimen would otherwise pay at every step for zeros.
   bool spin = s.any_rotating;
   if (spin && s.spin_known) {
     // What the last step left for the particles holding a bond (State::spin_known).
@@ -201,8 +200,9 @@ StageLoop bond_stage(State& s) {
       }
   }
   // Without spin no moment grows: while every beam moment is zero (a bonded specimen whose
-  // particles never turned: the joints) the kernel leaves the four moment columns alone, 0.94 of
-  // the joint's one-thread step (perf/README.md). A step with spin may give them values.
+  // particles never turned: the joints) the kernel leaves the four moment columns alone and its
+  // records carry no moment, memory traffic saved at every step. A step with spin may give them
+  // values.
   const auto kernel = spin ? s.kernels->bond
                            : (s.bond_moments_zero ? s.kernels->bond_no_moment : s.kernels->bond_norot);
   if (spin) s.bond_moments_zero = false;
@@ -224,11 +224,6 @@ StageLoop bond_stage(State& s) {
     breaks[blk] = kernel(args, begin, std::min(total, begin + block));
   };
   return st;  // no finish: the breaks are processed after the step (process_breaks)
-}
-
-void compute_bond_forces(State& s) {
-  StageLoop st = bond_stage(s);
-  run_stages(s, {&st});
 }
 
 void process_breaks(State& s) {
@@ -308,7 +303,7 @@ void process_breaks(State& s) {
   q = std::move(kept);
   refresh_bond_topology(s);
   // Into the pair list without a rebuild: a fracture run breaks bonds on most of its steps, and a
-  // rebuild each time (with a reorder every tenth) was ~1800 rebuilds in its first 0.3 mm.
+  // rebuild for each would rebuild the list (and reorder the particles) nearly every step.
   insert_pairs(s, freed);
 }
 

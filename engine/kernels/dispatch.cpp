@@ -35,15 +35,13 @@ std::vector<const KernelSet*> supported() {
 const KernelSet& select_kernels(const std::string& name) {
   const auto list = supported();
   if (name == "auto") return *list.front();
-  if (name == "float") return float_study_kernels();
   std::string valid = "auto";
   for (const auto* k : list) {
     if (name == k->name) return *k;
     valid += std::string(", ") + k->name;
   }
   throw Error("unknown or unsupported SIMD architecture '" + name + "' (valid on this CPU: " +
-              valid + "; also float: the force laws in single precision, scalar, for the "
-              "run-time-against-error study)");
+              valid + ")");
 }
 
 }  // namespace asperity::kernels

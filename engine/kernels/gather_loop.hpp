@@ -5,8 +5,7 @@
 //   bonds: f += s * (fx, fy, fz),   t += s * (mx, my, mz) - (R - U/2) * (cx, cy, cz)
 // with s = +1 on b, -1 on a, and the vector versions do exactly these operations on lanes 0-2
 // of the record's quarters (lane 3, the overlap or the padding, is computed and dropped), so the
-// sums are equal bit for bit. About 12 instructions per pair incidence against ~25
-// (perf/README.md).
+// sums are equal bit for bit, in about half the instructions per incidence.
 #pragma once
 #include <cstdint>
 
@@ -74,10 +73,9 @@ inline void gather_scalar(const GatherArgs& pairs, const GatherArgs* bonds, std:
 }
 
 #if defined(__AVX2__)
-// Records of the particle this many ahead (GatherArgs::prefetch): eight as measured on the AVX2
-// Zen 3 (sixteen: noise), 32 on the AVX-512 Zen 5, whose faster gather reaches the prefetched
-// lines sooner (lattice n = 40 0.96-0.97 on one thread, 0.94-0.98 on two; n = 100 0.97; 64 the
-// same as 32; perf/README.md).
+// Records of the particle this many ahead (GatherArgs::prefetch): far enough that the lines
+// arrive before the gather reaches them, and farther with AVX-512, whose gather gets through the
+// particles faster. Both distances are the best of trials, not derived.
 #if defined(__AVX512F__)
 inline constexpr std::size_t kGatherAhead = 32;
 #else
@@ -116,7 +114,7 @@ inline void add_incidences_vector(const GatherArgs& g, std::size_t i, __m256d R,
 
 // The same sums with one 256-bit vector per quarter record. Pairs and bonds in one pass: the
 // particle's sums stay in two registers from its first pair to its last bond instead of being
-// stored by a pair gather and loaded back by a bond gather (perf/README.md).
+// stored by a pair gather and loaded back by a bond gather.
 template <bool Bonds, bool Moment = Bonds>
 inline void gather_vector(const GatherArgs& pairs, const GatherArgs* bonds, std::size_t begin,
                           std::size_t end) {

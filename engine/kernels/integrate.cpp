@@ -61,8 +61,8 @@ StageLoop integrate_stage(State& s) {
   bond_args.entry = binc.entry.data();
   bond_args.records = bq.out.data();
   bond_args.moments = s.bond_records_with_moments;
-  // Records past the caches are prefetched a few particles ahead: lattice n = 40 (12 MB) 0.93 of
-  // the step time on one thread, 0.85 on two; in cache (the joint's bonds, 0.9 MB) it costs ~3 %.
+  // Records past the caches are prefetched a few particles ahead, as the incidences reach their
+  // lines out of order; records in cache are not (the prefetches would cost and hide nothing).
   pair_args.prefetch = records_past_caches(q.out);
   bond_args.prefetch = records_past_caches(bq.out);
   // The wall and applied terms, added in passes after them. Raw pointers captured by value: the
@@ -170,8 +170,7 @@ StageLoop integrate_stage(State& s) {
     for (std::size_t i = first; i < end; ++i) {
       // Only free particles are integrated: inert and idle ones move lazily with their group,
       // other members with it (bodies/groups.cpp). Without branches (`&`, not `&&`): in a joint
-      // the flags vary from particle to particle, and the mispredicted branches of this loop were
-      // 2.7 % of its step.
+      // the flags vary from particle to particle, and branches on them would be mispredicted.
       const int moves = int(inert[i] == 0) & int(idle[i] == 0) & int(group[i] < 0);
       const int turns = moves & int(locked[i] == 0);
       free[i - first] = double(moves);
@@ -196,11 +195,6 @@ StageLoop integrate_stage(State& s) {
     s.particle_blocks[blk] = r;
   };
   return st;
-}
-
-void gather_and_integrate(State& s) {
-  StageLoop st = integrate_stage(s);
-  run_stages(s, {&st});
 }
 
 }  // namespace asperity::detail

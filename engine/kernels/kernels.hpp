@@ -119,9 +119,9 @@ struct GatherArgs {
   const std::uint8_t* inert; const std::uint8_t* idle;
   double* fx; double* fy; double* fz;
   double* tx; double* ty; double* tz;
-  // Prefetch the records of the particle eight ahead (vector gathers only): for record arrays
-  // past the caches, whose lines the incidences reach out of order (kernels/integrate.cpp,
-  // records_past_caches in state.hpp; perf/README.md).
+  // Prefetch the records of the particle kGatherAhead ahead (vector gathers only, gather_loop.hpp):
+  // for record arrays past the caches, whose lines the incidences reach out of order
+  // (kernels/integrate.cpp, records_past_caches in state.hpp).
   bool prefetch = false;
   // Pair lists: per pair, 0 where its record is zero but for the overlap (PairKernelArgs::live,
   // from this step's pair kernel); the gather skips those records.
@@ -184,11 +184,7 @@ struct KernelSet {
 };
 
 const KernelSet& scalar_kernels();
-// The contact and bond laws in single precision (geometry, history and integration in double):
-// scalar, for issue 7's run-time-against-error study (kernels/float_study.cpp). Selected by the
-// name "float"; not among the architectures the SIMD tests compare bit for bit.
-const KernelSet& float_study_kernels();
-// The kernel set for `name` ("auto": the best the CPU supports; "float": float_study_kernels).
+// The kernel set for `name` ("auto": the best the CPU supports).
 // Throws asperity::Error for an unknown or unsupported name, listing the valid ones.
 const KernelSet& select_kernels(const std::string& name);
 

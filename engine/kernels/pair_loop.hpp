@@ -62,17 +62,17 @@ inline void store_pair(const PairKernelArgs& k, std::size_t i, const T& nx, cons
 // is about half as long; the operations are those of contact_forces, so the results are the
 // same bit for bit.
 //
-// On AVX-512 machines (Zen 5 here) the touching stages run in one pass instead (Lanes::kOnePass):
-// the larger out-of-order window overlaps the batches of the whole law, and the scratch's stores
-// and loads go (lattice n = 40: 0.91-0.93 of the step on one thread, ~0.975 on two;
-// perf/README.md). Same operations, same bits.
+// On AVX-512 machines the touching stages run in one pass instead (Lanes::kOnePass): there the
+// out-of-order window overlaps the batches of the whole law, and the scratch's stores and loads
+// go. Same operations, same bits.
 //
 // A stage in which no pair touches (U <= 0 for all its pairs) skips the law in pass 2: the law
 // would select zero shear force, zero slip energy and a zero rest overlap for each of them, and
 // fn and the record follow from those zeros by the same expressions. In a bonded specimen nearly
-// every listed pair is such a near miss (its touching pairs became bonds: 23 of the joint's 4070
-// pairs touch in mid-shear). The choice is per stage, not per batch, so that a scene in which
-// everything touches runs the loop it ran before (per batch it cost the lattice 2-3 %).
+// every listed pair is such a near miss (its touching pairs became bonds: a joint in mid-shear
+// has a few dozen touching among thousands listed). The choice is per stage, not per batch: a
+// check per batch would cost a scene in which everything touches (the lattice) and save it
+// nothing.
 template <class Lanes, bool Rotation>
 double pair_loop(const PairKernelArgs& k, std::size_t begin, std::size_t end) {
   using T = typename Lanes::Real;

@@ -27,14 +27,11 @@ namespace {
 
 // Records past the caches are written with non-temporal stores: the gather reads them out of
 // order long after (and prefetches them, integrate.cpp), so the lines need not be read for
-// ownership first. Where they would still be in cache it costs. Measured per machine in one
-// process (perf/README.md):
-// - AVX2 (Zen 3): above 4 MB; lattice n = 40 0.91-0.96 on one thread, 0.86-0.91 on two; n = 46
-//   0.90; in cache (n = 22) 1.16.
-// - AVX-512 (Zen 5, 32 MB L3, 1 MB L2 a core): past a third of the last-level cache on one thread
-//   (n = 30, 5 MB of records: 1.11; n = 34, 7.5 MB: 1.05; n = 40, 12 MB: 0.94; n = 70: 0.85), past
-//   the whole of it on two or more (n = 46, 19 MB: 1.04-1.09; n = 52, 26 MB: 1.13; n = 60, 41 MB:
-//   0.80; n = 100: 0.87), where the two cores' caches hold more of the step.
+// ownership first. Where they would still be in cache it costs: the gather then reads them from
+// memory. The thresholds are per SIMD set, each the best of trials on a machine with it:
+// - four lanes (AVX2): records past the caches (records_past_caches);
+// - eight lanes (AVX-512): past a third of the last-level cache on one thread, past the whole of
+//   it on two or more, where the cores' private caches hold more of the step.
 bool stream_pair_records(const State& s) {
   if (s.kernels->lanes != 8) return records_past_caches(s.pairs.out);
   const std::size_t bytes = s.pairs.out.size() * sizeof(double);
@@ -86,9 +83,9 @@ StageLoop pair_stage(State& s) {
   const auto kernel = pairs_can_spin(s) ? s.kernels->pair : s.kernels->pair_norot;
   // Live flags (PairKernelArgs::live) where most records are dead, so that the gather skips those
   // (GatherArgs::live): a bonded specimen's pairs are near misses whose particles are bonded
-  // elsewhere (2 cm joint in mid-shear: 20 of 1022 live; thesis scale: 1779 of 55 045), each a
-  // record line read per incidence. Where most touch (the lattice) the flags would cost 2-3 % of
-  // the step and save nothing, so a step counts them only every 64th step, to notice a change.
+  // elsewhere (a joint in mid-shear: a few per cent live), each a record line read per
+  // incidence. Where most touch (the lattice) the flags would cost their stores and save nothing,
+  // so they are written only every 64th step there, to notice a change.
   // Neither choice changes a bit of the results.
   PairStore& q = s.pairs;
   if (q.live_current) {
@@ -98,9 +95,8 @@ StageLoop pair_stage(State& s) {
   }
   q.live_written = s.pair_records_sparse || s.step % 64 == 0;
   if (!q.live_written) args.live = nullptr;
-  // A batch of pairs dead in the last step and in this one keeps its records (thesis-scale joint:
-  // 0.97-0.99 of the step in one process, perf/README.md): only where the flags are the last
-  // step's.
+  // A batch of pairs dead in the last step and in this one keeps its records instead of writing
+  // the same zeros again: only where the flags are the last step's.
   args.keep_dead_records = q.live_written && q.live_current;
   q.live_current = q.live_written;
   const std::size_t total = s.pairs.padded;
@@ -122,11 +118,6 @@ StageLoop pair_stage(State& s) {
       for (std::size_t blk = 0; blk < blocks; ++blk) s.ledger.friction += slip[blk];
   };
   return st;
-}
-
-void compute_pair_forces(State& s) {
-  StageLoop st = pair_stage(s);
-  run_stages(s, {&st});
 }
 
 }  // namespace asperity::detail

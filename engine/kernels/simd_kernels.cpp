@@ -22,15 +22,14 @@ struct SimdLanes {
   using Index = xsimd::batch<std::int64_t, Arch>;
   static constexpr std::size_t size = Real::size;
   // The pair loop in one pass over touching stages on AVX-512 machines, two on the others
-  // (pair_loop.hpp: each measured on its machine, perf/README.md).
+  // (pair_loop.hpp says why).
   static constexpr bool kOnePass = size == 8;
   static Index index(const std::int64_t* p) { return Index::load_aligned(p); }
   // xsimd 8's batch::gather passes two explicit template arguments to its kernels, which rules
-  // out its own AVX2 / AVX-512 double overloads and falls back to inserting lane by lane (a
-  // quarter of the lattice step's time). The hardware gathers are slower still on AMD's cores:
-  // Zen 2/3 microcode the AVX2 gather at about twice the cost of four scalar loads (0.84x of the
-  // lattice step), and on Zen 5 eight scalar loads beat the AVX-512 gather too (lattice n = 40
-  // 0.90-0.94x, bonded block 0.81x, joint 0.90x; perf/README.md). Same values, bit for bit.
+  // out its own AVX2 / AVX-512 double overloads and falls back to inserting lane by lane, slowly.
+  // The hardware gathers lose to scalar loads as well on AMD's cores (Zen 2 and 3 microcode the
+  // AVX2 gather; on Zen 5 eight scalar loads beat the AVX-512 one), so the lanes are loaded one
+  // by one and inserted here. Same values, bit for bit.
   static Real gather(const double* col, const Index& i) {
 #if defined(__AVX512F__)
     alignas(64) std::int64_t k[8];

@@ -1,9 +1,8 @@
 // The plane wall loop shared by the scalar reference and the SIMD kernels: per contact, the
 // plane's geometry [3-10, 3-11 with a plane for body a] and the contact law of model.md 4 with
-// the plane as body a (velocity of the plane, no spin, lever arm 0 on its side). Every operation
-// is the one the scalar wall stage did per contact (kernels/walls.cpp before this loop), so the
-// results are the same bit for bit; a contact that does not touch gets no force and forgets its
-// shear history, as there.
+// the plane as body a (velocity of the plane, no spin, lever arm 0 on its side). The scalar
+// reference and every SIMD set run this one loop, so their results are the same bit for bit; a
+// contact that does not touch gets no force and forgets its shear history.
 #pragma once
 #include "kernels/contact_law.hpp"
 #include "kernels/kernels.hpp"

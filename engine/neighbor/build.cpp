@@ -18,21 +18,19 @@
 //   streams, and in raster order a particle's neighbours ahead of it (+1 cell, +1 row, +1 plane)
 //   advance with it as three sequential streams, which the hardware prefetchers follow; a Morton
 //   curve keeps more neighbours close but jumps across its block boundaries, and a Hilbert curve
-//   never jumps but turns every few cells. Lattice, one process, same build (perf/README.md):
-//   raster order 0.89-0.91 of Morton's time per step at n = 40 (64 000 particles) on one thread,
-//   0.91-0.96 on two, 0.90 at n = 56, 0.95-0.98 at n = 30; Hilbert 1.03-1.04 at n = 40. Smaller
-//   scenes keep the Morton order: in cache it makes little difference (0.97-0.98 at n = 22), and
-//   any other order changes the rounding of every sum, and with it the packings and calibrations
-//   made so far (the REV of materials.lua, 935 particles, packs differently: E 15 % off).
+//   never jumps but turns every few cells. Smaller scenes keep the Morton order: in cache the
+//   order makes little difference, and any other order changes the rounding of every sum, and
+//   with it the packings and the calibrations made with them (the REV of materials.lua would
+//   pack differently).
 // - Rigid-group members follow the free particles, and inert members come last (each class along
 //   the curve): blocks of members then hold nothing to integrate. Scenes without groups (every
-//   packing, the lattice) are ordered as before, bit for bit. The joint's step: 0.97-0.98 on one
-//   thread, 0.98-1.00 on two; the rigid joint's 0.98 (perf/README.md).
+//   packing, the lattice) keep the curve's order alone.
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <numeric>
 
+#include "bodies/mesh.hpp"
 #include "state.hpp"
 
 namespace asperity::detail {

@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "asperity/world.hpp"
+#include "asperity/materials.hpp"
 #include "core/aligned.hpp"
 #include "store/columns.hpp"
 

@@ -5,7 +5,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "asperity/world.hpp"
+#include "asperity/materials.hpp"
+#include "asperity/vec3.hpp"
 #include "core/aligned.hpp"
 #include "store/columns.hpp"
 

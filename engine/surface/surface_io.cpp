@@ -2,7 +2,7 @@
 // grids.
 //
 // Design notes
-// - HDF5 layout (issue 4): dataset `height`, ny x nx IEEE little-endian doubles in metres, row = y
+// - HDF5 layout: dataset `height`, ny x nx IEEE little-endian doubles in metres, row = y
 //   index; attributes on the dataset: `spacing` (m), `units` = "m", and for generated maps the
 //   generation parameters under their SurfaceParams names (n, side, hurst_x, hurst_y,
 //   correlation_length_x, correlation_length_y, variance, variance_x, variance_y, seed, name).

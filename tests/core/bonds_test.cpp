@@ -604,17 +604,6 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
         EXPECT_EQ(0, std::memcmp(got.second[c].data(), ref.second[c].data(), bonds * sizeof(double)))
             << arch << " column " << c << (rest ? " rest" : "");
     }
-    // The "float" set (issue 7's study): every column to float precision against its largest
-    // magnitude; a bond right at the criterion may break in one and not the other.
-    const auto flt = run(kernels::select_kernels("float"), hist, rest);
-    EXPECT_NEAR(flt.first, ref.first, 0.01 * bonds);
-    std::size_t differ = 0;
-    for (int c = 0; c < 27; ++c) {
-      if (c == 17) continue;  // broken flags
-      differ += test::agree_to_scale(ref.second[c], flt.second[c], bonds, 1e-5,
-                                     "float column " + std::to_string(c));
-    }
-    EXPECT_GT(differ, std::size_t(bonds)) << "the float path must run";
   }
   // With every angular velocity +0 (bonded particles do not rotate), the kernel that does not
   // read them gives the same values bit for bit: the bond stage takes it then (bonds.cpp).

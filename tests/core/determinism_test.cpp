@@ -187,12 +187,6 @@ struct RandomPairs {
   std::vector<std::int64_t, AlignedAllocator<std::int64_t>> a, b;
   std::vector<double, AlignedAllocator<double>> nx, ny, nz, fsx, fsy, fsz, fn, U, rest;
   std::vector<double, AlignedAllocator<double>> out;  // records fx fy fz U cx cy cz fn per pair
-  // Column j of the records.
-  std::vector<double> record(std::size_t j) const {
-    std::vector<double> c(out.size() / 8);
-    for (std::size_t k = 0; k < c.size(); ++k) c[k] = out[8 * k + j];
-    return c;
-  }
   RandomPairs(std::size_t pairs, unsigned seed, bool shared = false) {
     const std::size_t n = shared ? test::a_particles(pairs) + pairs : 2 * pairs;
     std::mt19937_64 rng(seed);
@@ -449,39 +443,6 @@ TEST(Determinism, PairKernelWithoutSpinIsTheFullLawAtZeroSpin) {
         }
       }
     }
-  }
-}
-
-// The "float" kernel set (issue 7's study of single precision): the same law, every operation of
-// it rounded to float, the geometry in double. On the random pairs it must agree with the double
-// reference to float precision (a wrong formula would be off by O(1)), and not bit for bit (the
-// float path must really run).
-TEST(Determinism, FloatStudyPairKernelAgreesWithDoubleToFloatPrecision) {
-  const std::size_t pairs = 4096;
-  for (bool rotation : {true, false}) {
-    RandomPairs ref(pairs, 11, true), got(pairs, 11, true);
-    ref.with_rest = got.with_rest = true;
-    const auto& sk = kernels::scalar_kernels();
-    const auto& fk = kernels::select_kernels("float");
-    EXPECT_STREQ(fk.name, "float");
-    const double slip_ref = (rotation ? sk.pair : sk.pair_norot)(ref.args(), 0, pairs);
-    const double slip_got = (rotation ? fk.pair : fk.pair_norot)(got.args(), 0, pairs);
-    ref.outputs();
-    got.outputs();
-    EXPECT_NEAR(slip_got, slip_ref, 1e-5 * slip_ref);
-    // Each column against its largest magnitude: float keeps ~7 digits; the carried shear force
-    // goes through some forty float operations.
-    auto close = [&](const auto& u, const auto& v, double tol, const char* what) {
-      return test::agree_to_scale(u, v, pairs, tol, what);
-    };
-    EXPECT_EQ(close(ref.U, got.U, 1e-7, "overlap"), pairs) << "float values everywhere";
-    close(ref.nx, got.nx, 1e-7, "nx");
-    close(ref.fn, got.fn, 1e-6, "fn");
-    EXPECT_GT(close(ref.fsx, got.fsx, 1e-5, "fsx"), pairs / 4) << "touching pairs (a quarter to three quarters)";
-    close(ref.fsy, got.fsy, 1e-5, "fsy");
-    close(ref.fsz, got.fsz, 1e-5, "fsz");
-    close(ref.record(4), got.record(4), 1e-5, "cx");
-    close(ref.record(2), got.record(2), 1e-5, "fz");
   }
 }
 

@@ -1,13 +1,8 @@
 // Small scenes shared by the core tests.
 #pragma once
-#include <algorithm>
-#include <cmath>
 #include <cstdint>
 #include <random>
-#include <string>
 #include <utility>
-
-#include <gtest/gtest.h>
 
 #include "asperity/world.hpp"
 
@@ -24,22 +19,6 @@ inline std::pair<std::int64_t, std::int64_t> kernel_test_pair(std::size_t k, std
   if (!shared) return {std::int64_t(2 * k), std::int64_t(2 * k + 1)};
   const std::size_t m = a_particles(pairs);
   return {std::int64_t((k / 8) % 5 == 4 ? (7 * k) % m : k / 3), std::int64_t(m + k)};
-}
-
-// Expects got[k] within tol x (largest |ref|) of ref[k] for k < n, as a kernel of lower precision
-// must agree with the double reference column by column. Returns how many differ at all (a
-// column that never differs was not computed in that precision).
-template <class Ref, class Got>
-std::size_t agree_to_scale(const Ref& ref, const Got& got, std::size_t n, double tol,
-                           const std::string& what) {
-  double scale = 0;
-  for (std::size_t k = 0; k < n; ++k) scale = std::max(scale, std::abs(double(ref[k])));
-  std::size_t differ = 0;
-  for (std::size_t k = 0; k < n; ++k) {
-    EXPECT_NEAR(got[k], ref[k], tol * scale) << what << " entry " << k;
-    differ += got[k] != ref[k];
-  }
-  return differ;
 }
 
 // `n` spheres of random radius on a jittered grid (no overlaps) in a box of six planes, falling
