@@ -98,7 +98,7 @@ local P = params_lib.parse{
   {"cache", "", doc = "folder of cached specimens (\"\": $ASPERITY_CACHE, else ~/.cache/asperity, else out/cache)"},
   {"threads", 0, type = "integer", min = 0, doc = "0: automatic"},
   {"simd", "auto", oneof = {"auto", "scalar", "sse4_2", "avx2", "avx512f"},
-   doc = "kernels of closure and shear (results do not depend on it)"},
+   doc = "kernels of closure and shear (auto: the widest this CPU runs)"},
   {"progress", true, doc = "progress line on the terminal"},
   {"events_every", 0, type = "integer", min = 0,
    doc = "steps between energy samples for the event statistics (events.{h5,csv}); 0: none"},

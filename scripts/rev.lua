@@ -83,7 +83,7 @@ local P = params_lib.parse{
   {"cache", "", doc = "a folder: the packing is cached there and reused (calibrate_rev.lua)"},
   {"threads", 1, type = "integer", min = 0, doc = "0: automatic"},
   {"simd", "auto", oneof = {"auto", "scalar", "sse4_2", "avx2", "avx512f"},
-   doc = "kernels of bonding and tests (results do not depend on it)"},
+   doc = "kernels of bonding and tests (auto: the widest this CPU runs)"},
   {"out", "out/rev", nonempty = true, doc = "output folder"},
   check = function(P, fail)
     if P.platen >= P.size / 2 then fail("platen", ("must be < size / 2 (%g m)"):format(P.size / 2)) end
