@@ -1,5 +1,6 @@
-// Everything a World holds, in one struct the stages share. See engine/step.cpp for the order in
-// which the stages read and write it.
+// Everything a World holds: the world's data (State), what one step works with (StepContext) and
+// what is derived from the data and redone when it changes (Caches). See engine/step.cpp for the
+// order in which the stages read and write them.
 #pragma once
 #include <algorithm>
 #include <atomic>
@@ -25,8 +26,8 @@ struct Group {
   // A group whose rotation is fixed ("lazy") splits its other members at every neighbour build:
   // `busy` ones have something acting on them (a pair, bond or wall contact, an applied force) and
   // are summed and moved every step; the rest are idle (State::idle): their force is zero until
-  // the next build, so they are moved lazily like inert ones. A rigid joint moves its interface,
-  // not its volume (issue 7). Groups that may rotate keep every member busy.
+  // the next build, so they are moved lazily like inert ones: a rigid block then costs its
+  // interface, not its volume. Groups that may rotate keep every member busy.
   bool lazy = false;
   std::vector<std::int32_t> busy;
   Vec3 idle_shift{0, 0, 0};  // displacement not yet applied to the idle members
@@ -64,11 +65,10 @@ struct Ledger {
 inline constexpr std::size_t kPairBlock = 1024;      // multiple of kMaxLanes
 inline constexpr std::size_t kParticleBlock = 512;
 // The pair and bond stages' block for a list of `total` entries: kPairBlock, or smaller (down to
-// 256) so that a short list still makes 32 blocks. Two threads even out their shares by taking
-// each other's last blocks (step.cpp, run_stages); the joint's ~7000 bonds in 7 blocks of 1024
-// left one thread waiting for the other's last block (blocks of 256: 0.956 of its two-thread
-// step; the lattice of 187 000 pairs is slower with 256, so long lists keep 1024). A function of
-// the list alone, never of the thread count: the blocks' partial sums are combined in order.
+// 256) so that a short list still makes 32 blocks, which two threads can share out evenly by
+// taking each other's last blocks (step.cpp, run_stages); long lists keep the larger blocks,
+// which cost less per entry. A function of the list alone, never of the thread count: the
+// blocks' partial sums are combined in order.
 inline std::size_t pair_block_size(std::size_t total) {
   constexpr std::size_t stage = PairStore::kTouchStage;  // blocks of whole pair stages
   const std::size_t want = (total / 32 + stage - 1) / stage * stage;
@@ -77,8 +77,7 @@ inline std::size_t pair_block_size(std::size_t total) {
 
 // A per-pair or per-bond record array this large is taken to be past the caches: the pair kernel
 // writes it with non-temporal stores (kernels/pairs.cpp) and the gather prefetches it
-// (kernels/integrate.cpp). Measured on the AVX2 machine of perf/README.md: both pay at 12 MB
-// (lattice n = 40) and would cost 3-16 % at 2 MB (n = 22), where the records stay in cache.
+// (kernels/integrate.cpp); both pay only where the records do not stay in cache.
 inline bool records_past_caches(const AVec<double>& records) {
   return records.size() * sizeof(double) > (std::size_t(4) << 20);
 }
@@ -94,46 +93,62 @@ struct ParticleBlockResult {
   std::uint64_t spin_reachable = 0, spin_bonded = 0;
 };
 
-struct State {
-  WorldSettings settings;
-  ParticleStore p;
-  PairStore pairs;
-  // Fewer than half the pair records were live when the pair kernel last counted them
-  // (PairStore::live_current): the kernel flags them and the gather skips the dead ones
-  // (kernels/pairs.cpp). Kept here: a neighbour build replaces the pair store.
-  bool pair_records_sparse = false;
-  Incidence incidence;
-  WallStore walls;
-  std::vector<Group> groups;
-  BondStore bonds;
-  // Bonds held still: both ends in one rigid group that does not turn (Group::lazy). Such a bond
-  // never deforms and its forces cancel within the body, so the step leaves it out (a joint's
-  // platen layers hold a fifth of its bonds); it keeps its state, counts in the API, the energies
-  // and checkpoints, and goes back to `bonds` when its group may turn (settle_frozen_bonds).
-  // Sorted by (a, b) like `bonds`; never breaks while frozen.
-  BondStore frozen_bonds;
-  // Raised whenever the bond list changes (refresh_bond_topology): caches of bond indices check it.
-  std::uint64_t bond_version = 0;
-  Incidence bond_incidence;
-  // Bonded partners per particle (CSR, sorted): the neighbour search leaves bonded pairs out.
-  std::vector<std::int32_t> partner_start, partners;
-  // The particles holding a bond the step computes (frozen ones aside; refresh_bond_topology):
-  // the bond stage checks their angular velocities each step (kernels/bonds.cpp, bond_stage).
-  std::vector<std::int32_t> bonded_particles;
-  // Contacts that a broken bond left behind, waiting for a rebuild to merge them into the pair
-  // list: only a checkpoint written before breaks entered the list at once (process_breaks,
-  // insert_pairs) can hold some; the first rebuild after loading takes them.
-  PairStore inherited;
-  std::vector<BreakEvent> break_events;
+// A stage split around its block loop, so that step.cpp runs the loops of the pair, bond and
+// wall stages and then of the gather + integrate stage in one parallel region (run_stages)
+// instead of one region each: every fork and join costs the step a wait of all its threads.
+// `run(blk)` writes only block blk's slots; `finish` sums the blocks in order, so the results are
+// those of separate regions, bit for bit.
+struct StageLoop {
+  std::size_t blocks = 0;
+  bool after_barrier = false;  // its blocks start once every earlier stage's blocks are done
+  std::function<void(std::size_t)> run;
+  std::function<void()> finish;  // may be empty
+};
+
+// What a step works with besides the world's data: the kernels and threads it runs on, and its
+// scratch (per-block partial results, the group stages' member slots), rewritten every step.
+struct StepContext {
+  const kernels::KernelSet* kernels = nullptr;
+  int max_threads = 1;
+  // Automatic threads (settings.threads = 0): the cores other processes leave free, sampled every
+  // half second for the whole process (core/load.hpp, watch_load in step.cpp); 0: not known.
+  LoadWatch* load = &process_load();
+  int load_limit = 0;
+
+  std::vector<double> pair_block_slip;
   std::vector<double> bond_block_breaks;
-  bool any_rotating = true;  // some particle can rotate: kernels read angular velocities
+  std::vector<ParticleBlockResult> particle_blocks;
+  // The group stages (bodies/groups.cpp): the members moved every step (busy members of lazy
+  // groups, all members of the others) in slots by group (group g: moved_start[g] to
+  // moved_start[g + 1]) and member order, their slots by particle block (split_idle); per group
+  // its motion in this step, per slot the member's kinetic energy, squared displacement since
+  // the last build and whether its new position is finite.
+  std::vector<std::int32_t> moved_particle;
+  std::vector<std::size_t> moved_start;
+  Incidence block_moved;
+  std::vector<GroupStep> group_steps;
+  std::vector<double> member_kinetic, member_disp2;
+  std::vector<std::uint8_t> member_finite;
+};
+
+// Derived from the world's data and kept between steps because computing them every step costs:
+// each says when it is valid, and what the API changes reaches them through changed() (below).
+struct Caches {
+  // Bonded partners per particle (CSR, sorted): the neighbour search leaves bonded pairs out.
+  // With the bond incidence (the gather's CSR of the bonds) and the bonded particles, redone by
+  // refresh_bond_topology whenever the bond list changes.
+  Incidence bond_incidence;
+  std::vector<std::int32_t> partner_start, partners;
+  // The particles holding a bond the step computes (frozen ones aside): the bond stage checks
+  // their angular velocities each step (kernels/bonds.cpp, bond_stage).
+  std::vector<std::int32_t> bonded_particles;
   // Whether a particle spins (an angular velocity other than +0) as the last step left them: the
   // bits of wx, wy, wz ORed over the particles a pair can reach (not inert), and over the ones
   // holding a bond the step computes. The gather + integrate stage takes them per block after the
   // block moved, bookkeep adds the moved group members' new spin. Valid while spin_known: set by
-  // a step that ran with any_rotating, cleared by the API (touch, spins, inert flags, group
-  // motions) and by a new bond topology; the pair and bond stages read them instead of scanning
-  // the particles, serially, every step (on two threads the scans were ~5 % of the joint's step).
+  // a step that ran with any_rotating, cleared by the API (spins, inert flags, group motions) and
+  // by a new bond topology; the pair and bond stages read them instead of scanning the particles,
+  // serially, every step.
   bool spin_known = false;
   std::uint64_t spin_reachable = 0, spin_bonded = 0;
   // Every bond's beam moments are +-0 (set by a scan in refresh_bond_topology, cleared by a bond
@@ -143,15 +158,53 @@ struct State {
   // The layout of the bond records the last bond stage wrote (store/bonds.hpp): with the moment
   // (12 doubles a bond) or, by the kernel without moments, without (8). The gather reads them so.
   bool bond_records_with_moments = true;
+  // Fewer than half the pair records were live when the pair kernel last counted them
+  // (PairStore::live_current): the kernel flags them and the gather skips the dead ones
+  // (kernels/pairs.cpp). Kept here: a neighbour build replaces the pair store.
+  bool pair_records_sparse = false;
+  // Pairs joining two different bodies (group / group or group / free particle) of the current
+  // pair list, for the servo's per-step stiffness; valid while `rebuilds` equals group_pairs_at.
+  // Likewise the bonds joining two bodies (a joint's platens are tied by a few of its many
+  // bonds), valid while the bond list is the one of version group_bonds_of.
+  std::vector<std::uint32_t> group_pairs, group_bonds;
+  std::vector<std::uint32_t> group_bond_ends;  // per group: its ends of group_bonds
+  std::uint64_t group_pairs_at = ~std::uint64_t(0);
+  std::uint64_t group_bonds_of = ~std::uint64_t(0);  // the bond_version they were taken from
+  // Idle group members (see Group::busy), per particle index; valid while idle_valid (the split
+  // is redone at every neighbour build and after the API changes motions or applied forces).
+  std::vector<std::uint8_t> idle;
+  bool idle_valid = false;
+  // Per particle block (kParticleBlock): whether it holds a free particle (to integrate), and for
+  // the blocks that do not, their busy group members (the only ones the gather has to visit).
+  std::vector<std::uint8_t> block_free;
+  Incidence block_busy;
+};
+
+// The world's data: everything a checkpoint keeps, and the neighbour list built from it.
+struct State {
+  WorldSettings settings;
+  ParticleStore p;
+  PairStore pairs;
+  Incidence incidence;  // of `pairs`, rebuilt with them: the gather walks it
+  WallStore walls;
+  std::vector<Group> groups;
+  BondStore bonds;
+  // Bonds held still: both ends in one rigid group that does not turn (Group::lazy). Such a bond
+  // never deforms and its forces cancel within the body, so the step leaves it out; it keeps its
+  // state, counts in the API, the energies and checkpoints, and goes back to `bonds` when its
+  // group may turn (settle_frozen_bonds). Sorted by (a, b) like `bonds`; never breaks while frozen.
+  BondStore frozen_bonds;
+  // Raised whenever the bond list changes (refresh_bond_topology): caches of bond indices check it.
+  std::uint64_t bond_version = 0;
+  // Contacts that a broken bond left behind, waiting for a rebuild to merge them into the pair
+  // list: only a checkpoint written before breaks entered the list at once (process_breaks,
+  // insert_pairs) can hold some; the first rebuild after loading takes them.
+  PairStore inherited;
+  std::vector<BreakEvent> break_events;
+  bool any_rotating = true;  // some particle can rotate: kernels read angular velocities
   // Some bond was installed stress-free: the pair and bond kernels read rest overlaps (which are
   // all 0 otherwise, so a world without such bonds never reads the columns). Never reset.
   bool rest_overlaps = false;
-  const kernels::KernelSet* kernels = nullptr;
-  int max_threads = 1;
-  // Automatic threads (settings.threads = 0): the cores other processes leave free, sampled every
-  // half second for the whole process (core/load.hpp, watch_load in step.cpp); 0: not known.
-  LoadWatch* load = &process_load();
-  int load_limit = 0;
 
   double dt = 0;             // in use
   double dt_estimate = 0;    // last critical estimate (no safety factor)
@@ -179,59 +232,52 @@ struct State {
   double reference_input = 0;    // boundary + gravity work at that moment
   std::atomic<bool> stop_requested{false};
 
-  // Pairs joining two different bodies (group / group or group / free particle) of the current
-  // pair list, for the servo's per-step stiffness; valid while `rebuilds` equals group_pairs_at.
-  // Likewise the bonds joining two bodies (a joint's ~9000 bonds, of which a few hundred tie the
-  // platens: scanning them all every step was 3 % of its elastic step), valid while the bond list
-  // is the one of version group_bonds_of.
-  std::vector<std::uint32_t> group_pairs, group_bonds;
-  std::vector<std::uint32_t> group_bond_ends;  // per group: its ends of group_bonds
-  std::uint64_t group_pairs_at = ~std::uint64_t(0);
-  std::uint64_t group_bonds_of = ~std::uint64_t(0);  // the bond_version they were taken from
-
-  // Idle group members (see Group::busy), per particle index; valid while idle_valid (the split
-  // is redone at every neighbour build and after the API changes motions or applied forces).
-  std::vector<std::uint8_t> idle;
-  bool idle_valid = false;
-  // Per particle block (kParticleBlock): whether it holds a free particle (to integrate), and for
-  // the blocks that do not, their busy group members (the only ones the gather has to visit).
-  std::vector<std::uint8_t> block_free;
-  Incidence block_busy;
-
-  std::vector<double> pair_block_slip;
-  std::vector<ParticleBlockResult> particle_blocks;
-  // The group stages (bodies/groups.cpp): the members moved every step (busy members of lazy
-  // groups, all members of the others) in slots by group (group g: moved_start[g] to
-  // moved_start[g + 1]) and member order, their slots by particle block (split_idle); per group
-  // its motion in this step, per slot the member's kinetic energy, squared displacement since
-  // the last build and whether its new position is finite.
-  std::vector<std::int32_t> moved_particle;
-  std::vector<std::size_t> moved_start;
-  Incidence block_moved;
-  std::vector<GroupStep> group_steps;
-  std::vector<double> member_kinetic, member_disp2;
-  std::vector<std::uint8_t> member_finite;
+  StepContext ctx;
+  Caches cache;
 };
 
-// Stages of one step (engine/step.cpp runs them in this order).
-void build_neighbors(State& s);         // neighbor/build.cpp
-void ensure_skin(State& s);             // neighbor/build.cpp: derive the automatic skin if unset
-// A stage split around its block loop, so that step.cpp runs the loops of the pair, bond and
-// wall stages and then of the gather + integrate stage in one parallel region (run_stages)
-// instead of one region each: a fork/join costs ~4 us on two threads, ~10 % of a small joint's
-// step (perf/README.md). `run(blk)` writes only block blk's slots; `finish` sums the blocks in
-// order, so the results are those of separate regions, bit for bit.
-struct StageLoop {
-  std::size_t blocks = 0;
-  bool after_barrier = false;  // its blocks start once every earlier stage's blocks are done
-  std::function<void(std::size_t)> run;
-  std::function<void()> finish;  // may be empty
+// What a World call changed, for changed(): the one place that says what must be redone.
+enum class Change {
+  particles,       // positions, radii, membership...: rebuild; kinetic energy, its reference, spins
+  velocities,      // linear velocities: the kinetic energy and its reference
+  spins,           // angular velocities: also which particles spin
+  applied_forces,  // a group member with a force is busy: the idle split
+  group_motion,    // a group that may now rotate has no idle members; its members may spin
+  time_step,       // dt or its safety: a fresh estimate (and its check) before the next step
+  skin,            // the neighbour list
+  added,           // new particles: a reorder at the next build
 };
-StageLoop pair_stage(State& s);         // kernels/pairs.cpp
-StageLoop bond_stage(State& s);         // kernels/bonds.cpp
-StageLoop wall_stage(State& s);         // kernels/walls.cpp
-StageLoop integrate_stage(State& s);    // kernels/integrate.cpp: gather + integrate
-void run_stages(State& s, std::initializer_list<StageLoop*> stages);  // step.cpp
+inline void changed(State& s, Change c) {
+  switch (c) {
+    case Change::particles:
+      s.need_rebuild = true;  // the rebuild also redoes the busy / idle split of the groups
+      s.reference_energy = -1;
+      s.kinetic_valid = false;
+      s.cache.spin_known = false;
+      break;
+    case Change::velocities:
+      s.reference_energy = -1;
+      s.kinetic_valid = false;
+      break;
+    case Change::spins:
+      s.reference_energy = -1;
+      s.kinetic_valid = false;
+      s.cache.spin_known = false;
+      break;
+    case Change::applied_forces: s.cache.idle_valid = false; break;
+    case Change::group_motion:
+      s.cache.idle_valid = false;  // the split syncs the lazy members first
+      s.cache.spin_known = false;
+      break;
+    case Change::time_step:
+      s.last_estimate_step = 0;
+      s.need_rebuild = true;  // the build makes a fresh estimate and checks it
+      break;
+    case Change::skin: s.need_rebuild = true; break;
+    case Change::added: s.force_reorder = true; break;
+  }
+}
+
 // f(store, k) for every bond: the ones the step computes (s.bonds), then the frozen ones.
 template <class F>
 void for_each_bond(const State& s, F&& f) {
@@ -239,68 +285,19 @@ void for_each_bond(const State& s, F&& f) {
     for (std::size_t k = 0; k < q->n; ++k) f(*q, k);
 }
 
-kernels::PairKernelArgs pair_kernel_args(State& s);  // its kernel's arguments (perf/ reuses them)
-kernels::BondKernelArgs bond_kernel_args(State& s);  // its kernel's arguments (perf/ reuses them)
-void process_breaks(State& s);          // kernels/bonds.cpp: events, energy, compaction
-void refresh_bond_topology(State& s);   // kernels/bonds.cpp: incidence, partners, rotation locks
-// kernels/bonds.cpp: moves the bonds inside lazy groups (Group::lazy, set by the caller) to
-// State::frozen_bonds and the others back; true if any moved (the topology is then refreshed).
-bool settle_frozen_bonds(State& s);
-// Every bond, active and frozen, in one store sorted by (a, b) (checkpoints).
-BondStore all_bonds(const State& s);
-// x and y (each sorted by (a, b), no bond in both) in one store sorted by (a, b); its material
-// and `any` are left to the caller (kernels/bonds.cpp).
-BondStore merge_bonds(const BondStore& x, const BondStore& y);
-// CSR of the pairs (a, b) per particle, entries (k << 1) | (particle is b), ascending k.
-void build_incidence(std::size_t particles, const std::int64_t* a, const std::int64_t* b,
-                     std::size_t count, Incidence& inc);
-// neighbor/build.cpp: pair k of q (a and b set) as the search starts a new one: the current
-// direction as its previous normal, no shear or normal force, no rest overlap. Returns the
-// centres' distance.
-double start_pair(PairStore& q, std::size_t k, const ParticleStore& p);
-// neighbor/build.cpp: pairs the list lacks (sorted by (a, b), with their history) merged into it
-// between two rebuilds; the incidence is rebuilt and the group split redone at the next step.
-void insert_pairs(State& s, const PairStore& add);
-// Stage `groups` in three loops that run in the step's parallel region after the gather:
-// `servo` (the servo's stiffness, one block, while a servo acts), `motion` (one block per group:
-// its force and torque summed in member order, its degrees of freedom advanced) and `moves` (the
-// members moved, by particle block, on the thread that gathered the block). The finish of moves
-// adds the ledgers and kinetic energy in the order of a serial loop over groups and members, so
-// the results are bitwise those of one.
-struct GroupStages {
-  StageLoop servo, motion, moves;
-};
-GroupStages group_stages(State& s);     // bodies/groups.cpp; empty stages without groups
-double estimate_critical_dt(const State& s);  // step.cpp
-// The deepest contact overlap relative to the radius of the smaller body it joins (a wall counts
-// as infinitely large), over touching pairs, wall contacts and bonds; particle -1 and ratio 0
-// when nothing overlaps (step.cpp).
-struct OverlapRatio {
-  double ratio = 0;
-  std::int64_t particle = -1;
-};
-OverlapRatio deepest_overlap(const State& s);
-Energies compute_energies(const State& s);    // step.cpp
-void step_once(State& s);               // step.cpp
-void watch_load(State& s);              // step.cpp: State::load_limit, for automatic threads
-void update_servo_stiffness(State& s);  // bodies/groups.cpp: every step while a servo acts
-void sync_lazy(State& s);               // bodies/groups.cpp: bring inert and idle members up to date
-void split_idle(State& s);              // bodies/groups.cpp: busy / idle members of lazy groups
-
 // Threads for a parallel stage. Automatic (settings.threads == 0): one per 10 000 units of
 // force work, a pair counting one and a bond two (its kernel and gather cost about twice a
 // pair's), or one per 20 000 particles if that is more (before the first pair list), up to the
 // cores available. Below that, thread start-up and barriers cost more than they save, and on a
-// loaded machine a spinning thread makes a small scene many times slower. Measured on two cores
-// (perf/README.md, "Threads"): the default elastic joint (4 031 pairs, 9 098 bonds) gains from a
-// second thread; its rigid twin (161 pairs) loses. The results do not depend on the count.
-// Also no more than the cores that other processes leave free (State::load_limit): a thread that
-// shares its core with a busy process holds the others up at every barrier.
+// loaded machine a spinning thread makes a small scene many times slower (perf/README.md,
+// "Threads"). The results do not depend on the count. Also no more than the cores that other
+// processes leave free (StepContext::load_limit): a thread that shares its core with a busy
+// process holds the others up at every barrier.
 inline int thread_count(const State& s) {
   if (s.settings.threads > 0) return s.settings.threads;
   const std::size_t work = s.pairs.n + 2 * s.bonds.n;
   const std::size_t extra = std::max(work / 10000, s.p.n / 20000);
-  const int cores = s.load_limit > 0 ? std::min(s.max_threads, s.load_limit) : s.max_threads;
+  const int cores = s.ctx.load_limit > 0 ? std::min(s.ctx.max_threads, s.ctx.load_limit) : s.ctx.max_threads;
   return std::clamp(int(std::min<std::size_t>(extra, 1024)) + 1, 1, std::max(1, cores));
 }
 

@@ -16,7 +16,14 @@
 #include <memory>
 #include <sstream>
 
-#include "state.hpp"
+#include "step.hpp"
+// The stages, in the order a step runs them:
+#include "neighbor/build.hpp"    // 1
+#include "kernels/pairs.hpp"     // 2
+#include "kernels/bonds.hpp"     // 3
+#include "kernels/walls.hpp"     // 4
+#include "kernels/integrate.hpp" // 5 + 7
+#include "bodies/groups.hpp"     // 6
 
 namespace asperity::detail {
 
@@ -54,7 +61,7 @@ void bookkeep(State& s) {
   const ParticleStore& p = s.p;
   double max_disp2 = 0, worst = 0;
   std::int64_t worst_i = -1;
-  for (const auto& r : s.particle_blocks) {
+  for (const auto& r : s.ctx.particle_blocks) {
     s.kinetic_at_step += r.kinetic;
     if (s.settings.track_energy) {
       s.ledger.damping += r.damping;
@@ -73,24 +80,24 @@ void bookkeep(State& s) {
   // A step that started from a known answer adds to it (integrate.cpp: only its blocks with
   // rotation were read); one that did not took every block's and starts it afresh.
   if (!s.any_rotating) {
-    s.spin_known = false;  // the blocks took no ORs
+    s.cache.spin_known = false;  // the blocks took no ORs
   } else {
     std::uint64_t reachable = 0, bonded = 0;
-    for (const auto& r : s.particle_blocks) {
+    for (const auto& r : s.ctx.particle_blocks) {
       reachable |= r.spin_reachable;
       bonded |= r.spin_bonded;
     }
     std::uint64_t members = 0;
     if (!s.groups.empty())
-      for (const GroupStep& gs : s.group_steps)
+      for (const GroupStep& gs : s.ctx.group_steps)
         if (gs.moves)
           members |= std::bit_cast<std::uint64_t>(gs.angular_velocity.x) |
                      std::bit_cast<std::uint64_t>(gs.angular_velocity.y) |
                      std::bit_cast<std::uint64_t>(gs.angular_velocity.z);
-    if (!s.spin_known) s.spin_reachable = s.spin_bonded = 0;
-    s.spin_reachable |= reachable | members;
-    s.spin_bonded |= bonded | members;
-    s.spin_known = true;
+    if (!s.cache.spin_known) s.cache.spin_reachable = s.cache.spin_bonded = 0;
+    s.cache.spin_reachable |= reachable | members;
+    s.cache.spin_bonded |= bonded | members;
+    s.cache.spin_known = true;
   }
   // Group members were moved by the group stages: the largest displacement of each group (its idle
   // members have moved by at most idle_base + |idle_shift|, split_idle).
@@ -106,10 +113,10 @@ void bookkeep(State& s) {
     const Group& g = s.groups[gi];
     double d2 = 0;
     // The moved members in member order, as the moves stage left them (bodies/groups.cpp).
-    for (std::size_t slot = s.moved_start[gi]; slot < s.moved_start[gi + 1]; ++slot) {
-      d2 = std::max(d2, s.member_disp2[slot]);
-      if (!s.member_finite[slot]) {
-        const std::int32_t i = s.moved_particle[slot];
+    for (std::size_t slot = s.ctx.moved_start[gi]; slot < s.ctx.moved_start[gi + 1]; ++slot) {
+      d2 = std::max(d2, s.ctx.member_disp2[slot]);
+      if (!s.ctx.member_finite[slot]) {
+        const std::int32_t i = s.ctx.moved_particle[slot];
         health_error(s, "non-finite position", i, "x", p.x[i]);
       }
     }
@@ -418,8 +425,8 @@ void run_stages(State& s, std::initializer_list<StageLoop*> stages) {
 }
 
 void watch_load(State& s) {
-  if (s.settings.threads > 0 || s.max_threads <= 1) return;  // fixed, or nothing to choose
-  s.load_limit = s.load->limit(LoadWatch::now());             // a clock read; a sample each 0.5 s
+  if (s.settings.threads > 0 || s.ctx.max_threads <= 1) return;  // fixed, or nothing to choose
+  s.ctx.load_limit = s.ctx.load->limit(LoadWatch::now());             // a clock read; a sample each 0.5 s
 }
 
 // Moved group members from which the group stages run in the step's parallel region.
@@ -430,7 +437,7 @@ void step_once(State& s) {
   const bool rebuilt = s.need_rebuild;
   if (rebuilt) build_neighbors(s);
   const bool estimate_due = s.step >= s.last_estimate_step + std::uint64_t(s.settings.dt_interval);
-  if (!s.idle_valid) split_idle(s);
+  if (!s.cache.idle_valid) split_idle(s);
   if (rebuilt || estimate_due || s.dt <= 0) check_dt(s);
   // The three force stages, then gather + integrate, in one parallel region (state.hpp,
   // StageLoop); the ledgers and wall forces are summed after it.
@@ -444,7 +451,7 @@ void step_once(State& s) {
     // joint), so that no thread waits while another moves them. Where few move, their two more
     // barriers would cost more than they save, so those stages run after the region.
     GroupStages g = group_stages(s);
-    if (s.moved_particle.size() >= kParallelMoves) {
+    if (s.ctx.moved_particle.size() >= kParallelMoves) {
       run_stages(s, {&pairs, &bonds, &walls, &particles, &g.servo, &g.motion, &g.moves});
     } else {  // on one thread, the same sums in the same order as the call above
       run_stages(s, {&pairs, &bonds, &walls, &particles});

@@ -11,12 +11,18 @@
 #include <numbers>
 #include <sstream>
 
+#include "bodies/groups.hpp"
 #include "bodies/mesh.hpp"
 #include "kernels/bond_law.hpp"
+#include "kernels/bonds.hpp"
+#include "neighbor/build.hpp"
 #include "state.hpp"
+#include "step.hpp"
 
 namespace asperity {
 
+using detail::Change;
+using detail::changed;
 using detail::State;
 
 namespace {
@@ -100,13 +106,6 @@ void set_mass(detail::ParticleStore& p, std::size_t i) {
   p.inv_inertia[i] = 1.0 / p.inertia[i];
 }
 
-void touch(State& s) {  // the user changed the state: rebuild, re-estimate, re-reference energy
-  s.need_rebuild = true;  // the rebuild also redoes the busy / idle split of the groups
-  s.reference_energy = -1;
-  s.kinetic_valid = false;
-  s.spin_known = false;  // the next pair and bond stages scan for spin (State::spin_known)
-}
-
 void recompute_group(State& s, detail::Group& g) {
   detail::sync_lazy(s);
   const auto& p = s.p;
@@ -147,8 +146,8 @@ double Energies::balance_error(const Energies& initial) const {
 World::World(WorldSettings settings) : state_(std::make_unique<State>()) {
   State& s = *state_;
   for_each_setting(settings, [](const Field& f, const auto& v) { check_value("", f, v); });
-  s.kernels = &kernels::select_kernels(settings.simd);
-  s.max_threads = omp_get_max_threads();
+  s.ctx.kernels = &kernels::select_kernels(settings.simd);
+  s.ctx.max_threads = omp_get_max_threads();
   s.settings = settings;
   // The first reading of the machine's load, so that the automatic thread count knows it by the
   // time the scene is built and stepping starts (core/load.hpp).
@@ -160,7 +159,7 @@ World::World(WorldSettings settings) : state_(std::make_unique<State>()) {
   s.pairs.fill_padding(s.p.null_a(), s.p.null_b());
   s.bonds.resize(0);
   s.bonds.fill_padding(s.p.null_a(), s.p.null_b());
-  s.partner_start.assign(1, 0);
+  s.cache.partner_start.assign(1, 0);
   s.any_rotating = settings.rotation;
 }
 
@@ -230,12 +229,12 @@ std::int64_t World::add_particles(std::span<const double> xyz, std::span<const d
     p.id[i] = first_id + std::int64_t(k);
     p.index_of_id.push_back(std::int64_t(i));
   }
-  s.partner_start.resize(p.n + 1, s.partner_start.empty() ? 0 : s.partner_start.back());
+  s.cache.partner_start.resize(p.n + 1, s.cache.partner_start.empty() ? 0 : s.cache.partner_start.back());
   s.any_rotating = s.any_rotating || s.settings.rotation;
   // Bond and pair padding point at null particles, whose indices moved with the new count.
   s.bonds.fill_padding(p.null_a(), p.null_b());
-  s.force_reorder = true;
-  touch(s);
+  changed(s, Change::added);
+  changed(s, Change::particles);
   return first_id;
 }
 
@@ -283,7 +282,7 @@ void World::set_position(std::int64_t id, Vec3 x) {
   p.x[i] = x.x;
   p.y[i] = x.y;
   p.z[i] = x.z;
-  touch(*state_);
+  changed(*state_, Change::particles);
 }
 void World::set_velocity(std::int64_t id, Vec3 v) {
   require_finite(v, "velocity");
@@ -294,8 +293,7 @@ void World::set_velocity(std::int64_t id, Vec3 v) {
   p.vx[i] = v.x;
   p.vy[i] = v.y;
   p.vz[i] = v.z;
-  state_->reference_energy = -1;
-  state_->kinetic_valid = false;
+  changed(*state_, Change::velocities);
 }
 void World::set_angular_velocity(std::int64_t id, Vec3 w) {
   require_finite(w, "angular velocity");
@@ -306,9 +304,7 @@ void World::set_angular_velocity(std::int64_t id, Vec3 w) {
   p.wx[i] = w.x;
   p.wy[i] = w.y;
   p.wz[i] = w.z;
-  state_->reference_energy = -1;
-  state_->kinetic_valid = false;
-  state_->spin_known = false;
+  changed(*state_, Change::spins);
 }
 void World::set_radius(std::int64_t id, double r) {
   require_radius(r, "set_radius: radius");
@@ -317,7 +313,7 @@ void World::set_radius(std::int64_t id, double r) {
   p.radius[i] = r;
   set_mass(p, i);
   for (auto& g : state_->groups) recompute_group(*state_, g);
-  touch(*state_);
+  changed(*state_, Change::particles);
 }
 void World::scale_radii(double factor) {
   require(factor > 0 && std::isfinite(factor), "scale_radii: factor must be > 0, got " + num(factor));
@@ -332,7 +328,7 @@ void World::scale_radii(double factor) {
   }
   for (auto& g : state_->groups) recompute_group(*state_, g);
   state_->skin = 0;  // re-derive an automatic skin from the new radii
-  touch(*state_);
+  changed(*state_, Change::particles);
 }
 void World::set_applied_force(std::int64_t id, Vec3 f) {
   require_finite(f, "applied force");
@@ -345,7 +341,7 @@ void World::set_applied_force(std::int64_t id, Vec3 f) {
   p.ax[i] = f.x;
   p.ay[i] = f.y;
   p.az[i] = f.z;
-  state_->idle_valid = false;  // an idle group member with a force is busy
+  changed(*state_, Change::applied_forces);
 }
 void World::set_rotation_locked(std::int64_t id, bool locked) {
   const auto i = index_of(*state_, id);
@@ -389,7 +385,7 @@ int World::add_plane(Vec3 point, Vec3 normal, ContactMaterial material) {
   double len = norm(normal);
   if (!(len > 0 && std::isfinite(len))) {
     // |n|^2 of {0, 0, 1e200} overflows (of {1e-200, 0, 0} underflows): scaled by its largest
-    // component first. Only then, so that every other normal comes out bit for bit as before.
+    // component first. Only then: the division would round every other normal differently.
     normal = normal / big;
     len = norm(normal);
   }
@@ -400,7 +396,7 @@ int World::add_plane(Vec3 point, Vec3 normal, ContactMaterial material) {
   w.normal = normal / len;
   w.material = material;
   state_->walls.walls.push_back(w);
-  touch(*state_);
+  changed(*state_, Change::particles);
   return int(state_->walls.walls.size()) - 1;
 }
 
@@ -463,7 +459,7 @@ int World::add_mesh(std::span<const Vec3> vertices, std::span<const std::array<i
   w.mesh = int(state_->walls.meshes.size()) - 1;
   w.material = material;
   state_->walls.walls.push_back(w);
-  touch(*state_);
+  changed(*state_, Change::particles);
   return int(state_->walls.walls.size()) - 1;
 }
 
@@ -479,7 +475,7 @@ void World::remove_wall(int wall) {
   w.removed = true;
   w.velocity = {0, 0, 0};
   w.force = {0, 0, 0};
-  touch(*state_);
+  changed(*state_, Change::particles);
 }
 std::size_t World::wall_count() const { return state_->walls.walls.size(); }
 
@@ -533,7 +529,7 @@ int World::add_group(std::span<const std::int64_t> ids, GroupMotion motion) {
   grp.velocity = {0, 0, 0};
   s.groups.push_back(std::move(grp));
   set_group_motion(g, motion);
-  touch(s);
+  changed(s, Change::particles);
   return g;
 }
 
@@ -554,8 +550,7 @@ void World::set_group_motion(int group, const GroupMotion& motion) {
     }
   }
   g.motion = motion;
-  state_->idle_valid = false;  // a group that may now rotate has no idle members (the split syncs first)
-  state_->spin_known = false;
+  changed(*state_, Change::group_motion);
 }
 const GroupMotion& World::group_motion(int group) const { return state_->groups[check_group(*state_, group)].motion; }
 void World::set_group_applied_force(int group, Vec3 f) {
@@ -599,7 +594,7 @@ void World::set_inert(std::span<const std::int64_t> ids, bool inert) {
     for (auto i : all) (s.p.inert[i] ? g.inert : g.members).push_back(i);
     recompute_group(s, g);
   }
-  touch(s);
+  changed(s, Change::particles);
 }
 
 std::size_t World::inert_count() const {
@@ -746,7 +741,7 @@ std::size_t World::install_bonds(const BondMaterial& material, double tolerance,
   s.frozen_bonds.any = true;
   if (stress_free && !picked.empty()) s.rest_overlaps = true;
   detail::refresh_bond_topology(s);
-  touch(s);  // bonded pairs leave the contact list
+  changed(s, Change::particles);  // bonded pairs leave the contact list
   return picked.size();
 }
 
@@ -768,8 +763,7 @@ void World::remove_bonds() {
   s.frozen_bonds.resize(0);
   s.p.bonds_broken.assign(s.p.n, 0);  // no bond left, none counts as broken
   detail::refresh_bond_topology(s);
-  touch(s);  // the freed pairs enter the contact list at the next rebuild
-  s.reference_energy = -1;
+  changed(s, Change::particles);  // the freed pairs enter the contact list at the next rebuild
 }
 
 double World::bond_criterion(double sigma, double tau, double tensile_strength) {
@@ -910,14 +904,12 @@ void World::set_dt(double dt) {
   check_setting("set_dt", "dt", dt);
   state_->dt_fixed = dt > 0;
   state_->dt = dt;
-  state_->last_estimate_step = 0;
-  state_->need_rebuild = true;  // forces a fresh estimate (and its check) before the next step
+  changed(*state_, Change::time_step);
 }
 void World::set_dt_safety(double f) {
   check_setting("set_dt_safety", "dt_safety", f);
   state_->settings.dt_safety = f;
-  state_->last_estimate_step = 0;
-  state_->need_rebuild = true;  // a fresh estimate before the next step
+  changed(*state_, Change::time_step);
 }
 void World::set_friction(double mu) {
   ContactMaterial m = state_->settings.contact;
@@ -936,7 +928,7 @@ void World::set_skin(double skin) {
   check_setting("set_skin", "skin", skin);
   state_->settings.skin = skin;
   state_->skin = skin;
-  state_->need_rebuild = true;
+  changed(*state_, Change::skin);
 }
 double World::critical_dt() {
   State& s = *state_;
@@ -949,7 +941,7 @@ void World::set_threads(int threads) {
   check_setting("set_threads", "threads", threads);
   state_->settings.threads = threads;
 }
-std::string World::simd_architecture() const { return state_->kernels->name; }
+std::string World::simd_architecture() const { return state_->ctx.kernels->name; }
 StepStats World::stats() const {
   const State& s = *state_;
   StepStats st;
@@ -960,7 +952,7 @@ StepStats World::stats() const {
   st.contacts = contact_count();
   for (std::size_t k = 0; k < s.walls.contacts.n; ++k) st.wall_contacts += s.walls.contacts.overlap[k] > 0;
   st.threads = detail::thread_count(s);
-  st.busy_elsewhere = s.settings.threads > 0 ? -1.0 : s.load->others();
+  st.busy_elsewhere = s.settings.threads > 0 ? -1.0 : s.ctx.load->others();
   return st;
 }
 void World::rebuild_neighbors() {

@@ -34,7 +34,13 @@
 #include "core/aligned.hpp"
 #include "kernels/kernels.hpp"
 #include "lattice_scene.hpp"
+#include "kernels/bonds.hpp"
+#include "kernels/integrate.hpp"
+#include "kernels/pairs.hpp"
+#include "kernels/walls.hpp"
+#include "neighbor/build.hpp"
 #include "state.hpp"
+#include "step.hpp"
 
 namespace {
 

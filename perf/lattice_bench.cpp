@@ -24,7 +24,13 @@
 #include <utility>
 
 #include "lattice_scene.hpp"
+#include "kernels/bonds.hpp"
+#include "kernels/integrate.hpp"
+#include "kernels/pairs.hpp"
+#include "kernels/walls.hpp"
+#include "neighbor/build.hpp"
 #include "state.hpp"
+#include "step.hpp"
 
 namespace {
 

@@ -11,6 +11,8 @@
 
 #include <Eigen/Dense>
 
+#include "bodies/groups.hpp"
+#include "kernels/bonds.hpp"
 #include "state.hpp"
 
 namespace asperity::detail {
@@ -32,10 +34,10 @@ namespace {
 
 // The motion of group gi in this step (stage `motion` of group_stages): its members' force and
 // torque summed in member order, each degree of freedom advanced by its mode, the centre moved.
-// What its members' moves need, and its terms of the ledgers, go to s.group_steps[gi].
+// What its members' moves need, and its terms of the ledgers, go to s.ctx.group_steps[gi].
 void advance_group_motion(State& s, std::size_t gi) {
   Group& grp = s.groups[gi];
-  GroupStep& out = s.group_steps[gi];
+  GroupStep& out = s.ctx.group_steps[gi];
   out = GroupStep{};
   if (grp.members.empty()) return;
   const ParticleStore& p = s.p;
@@ -45,8 +47,8 @@ void advance_group_motion(State& s, std::size_t gi) {
   // Idle members of a lazy group carry no force (split_idle): summing and moving the busy ones
   // (the group's slots of moved_particle, in member order) is the whole group.
   Vec3 F = grp.applied, T{0, 0, 0};
-  for (std::size_t slot = s.moved_start[gi]; slot < s.moved_start[gi + 1]; ++slot) {
-    const std::int32_t i = s.moved_particle[slot];
+  for (std::size_t slot = s.ctx.moved_start[gi]; slot < s.ctx.moved_start[gi + 1]; ++slot) {
+    const std::int32_t i = s.ctx.moved_particle[slot];
     const Vec3 f{p.fx[i], p.fy[i], p.fz[i]};
     const Vec3 r = Vec3{p.x[i], p.y[i], p.z[i]} - grp.centre;
     F += f;
@@ -165,11 +167,11 @@ void move_members(State& s, std::size_t blk) {
   // A block's slots ascend, and the slots run over the groups in order: the group of a slot is
   // found by walking the groups' slot ranges.
   std::size_t g = 0;
-  for (std::int32_t e = s.block_moved.start[blk]; e < s.block_moved.start[blk + 1]; ++e) {
-    const std::size_t slot = std::size_t(s.block_moved.entry[e]);
-    while (slot >= s.moved_start[g + 1]) ++g;
-    const std::int32_t i = s.moved_particle[slot];
-    const GroupStep& st = s.group_steps[g];
+  for (std::int32_t e = s.ctx.block_moved.start[blk]; e < s.ctx.block_moved.start[blk + 1]; ++e) {
+    const std::size_t slot = std::size_t(s.ctx.block_moved.entry[e]);
+    while (slot >= s.ctx.moved_start[g + 1]) ++g;
+    const std::int32_t i = s.ctx.moved_particle[slot];
+    const GroupStep& st = s.ctx.group_steps[g];
     Vec3 r = Vec3{p.x[i], p.y[i], p.z[i]} - st.old_centre;
     if (st.spins) r = rotate(r, st.theta);
     const Vec3 x = st.centre + r;
@@ -180,14 +182,14 @@ void move_members(State& s, std::size_t blk) {
     // The rotational term is an exact +0 where the group does not turn (adding it changes no bit
     // of the non-negative translational one): its inertia is not read then.
     if (!(wmid == Vec3{})) kinetic += 0.5 * p.inertia[i] * dot(wmid, wmid);
-    s.member_kinetic[slot] = kinetic;
+    s.ctx.member_kinetic[slot] = kinetic;
     p.x[i] = x.x; p.y[i] = x.y; p.z[i] = x.z;
     p.vx[i] = v.x; p.vy[i] = v.y; p.vz[i] = v.z;
     p.wx[i] = st.angular_velocity.x; p.wy[i] = st.angular_velocity.y; p.wz[i] = st.angular_velocity.z;
     // For the rebuild criterion and the health check (bookkeep), while the member is at hand.
     const double dx = x.x - p.x0[i], dy = x.y - p.y0[i], dz = x.z - p.z0[i];
-    s.member_disp2[slot] = dx * dx + dy * dy + dz * dz;
-    s.member_finite[slot] = std::isfinite(x.x + x.y + x.z);
+    s.ctx.member_disp2[slot] = dx * dx + dy * dy + dz * dz;
+    s.ctx.member_finite[slot] = std::isfinite(x.x + x.y + x.z);
   }
 }
 
@@ -203,10 +205,10 @@ bool any_servo(const State& s) {
 GroupStages group_stages(State& s) {
   GroupStages st;
   if (s.groups.empty()) return st;
-  s.group_steps.assign(s.groups.size(), GroupStep{});
-  s.member_kinetic.resize(s.moved_particle.size());
-  s.member_disp2.resize(s.moved_particle.size());
-  s.member_finite.resize(s.moved_particle.size());
+  s.ctx.group_steps.assign(s.groups.size(), GroupStep{});
+  s.ctx.member_kinetic.resize(s.ctx.moved_particle.size());
+  s.ctx.member_disp2.resize(s.ctx.moved_particle.size());
+  s.ctx.member_finite.resize(s.ctx.moved_particle.size());
   if (any_servo(s)) {
     st.servo.blocks = 1;  // reads the force stages' overlaps only: no barrier of its own
     st.servo.run = [&s](std::size_t) { update_servo_stiffness(s); };
@@ -214,7 +216,7 @@ GroupStages group_stages(State& s) {
   st.motion.blocks = s.groups.size();
   st.motion.after_barrier = true;  // every member's force gathered, the servo's stiffness known
   st.motion.run = [&s](std::size_t g) { advance_group_motion(s, g); };
-  st.moves.blocks = s.block_moved.start.empty() ? 0 : s.block_moved.start.size() - 1;
+  st.moves.blocks = s.ctx.block_moved.start.empty() ? 0 : s.ctx.block_moved.start.size() - 1;
   st.moves.after_barrier = true;  // every group's motion
   st.moves.run = [&s](std::size_t blk) { move_members(s, blk); };
   st.moves.finish = [&s] {
@@ -224,7 +226,7 @@ GroupStages group_stages(State& s) {
     double kinetic = 0;
     std::size_t slot = 0;
     for (std::size_t g = 0; g < s.groups.size(); ++g) {
-      const GroupStep& gs = s.group_steps[g];
+      const GroupStep& gs = s.ctx.group_steps[g];
       if (!gs.moves) continue;
       if (s.settings.track_energy) {
         s.ledger.boundary += gs.boundary;
@@ -232,8 +234,8 @@ GroupStages group_stages(State& s) {
         s.ledger.gravity += gs.gravity;
       }
       kinetic += gs.kinetic;
-      const std::size_t end = s.moved_start[g + 1];
-      for (; slot < end; ++slot) kinetic += s.member_kinetic[slot];
+      const std::size_t end = s.ctx.moved_start[g + 1];
+      for (; slot < end; ++slot) kinetic += s.ctx.member_kinetic[slot];
     }
     s.kinetic_at_step = kinetic;  // the free particles' share is added in bookkeeping
   };
@@ -251,20 +253,20 @@ void update_servo_stiffness(State& s) {
     for (Dof d : g.motion.translation) servo = servo || d == Dof::servo;
   if (!servo) return;
   const ParticleStore& p = s.p;
-  if (s.group_pairs_at != s.rebuilds || s.group_bonds_of != s.bond_version ||
-      s.group_bond_ends.size() != s.groups.size()) {
-    s.group_pairs.clear();
+  if (s.cache.group_pairs_at != s.rebuilds || s.cache.group_bonds_of != s.bond_version ||
+      s.cache.group_bond_ends.size() != s.groups.size()) {
+    s.cache.group_pairs.clear();
     for (std::size_t k = 0; k < s.pairs.n; ++k)
-      if (p.group[s.pairs.a[k]] != p.group[s.pairs.b[k]]) s.group_pairs.push_back(std::uint32_t(k));
-    s.group_bonds.clear();
+      if (p.group[s.pairs.a[k]] != p.group[s.pairs.b[k]]) s.cache.group_pairs.push_back(std::uint32_t(k));
+    s.cache.group_bonds.clear();
     for (std::size_t k = 0; k < s.bonds.n; ++k)
-      if (p.group[s.bonds.a[k]] != p.group[s.bonds.b[k]]) s.group_bonds.push_back(std::uint32_t(k));
-    s.group_bond_ends.assign(s.groups.size(), 0);
-    for (std::uint32_t k : s.group_bonds)
+      if (p.group[s.bonds.a[k]] != p.group[s.bonds.b[k]]) s.cache.group_bonds.push_back(std::uint32_t(k));
+    s.cache.group_bond_ends.assign(s.groups.size(), 0);
+    for (std::uint32_t k : s.cache.group_bonds)
       for (const std::int64_t i : {s.bonds.a[k], s.bonds.b[k]})
-        if (p.group[i] >= 0) ++s.group_bond_ends[std::size_t(p.group[i])];
-    s.group_pairs_at = s.rebuilds;
-    s.group_bonds_of = s.bond_version;
+        if (p.group[i] >= 0) ++s.cache.group_bond_ends[std::size_t(p.group[i])];
+    s.cache.group_pairs_at = s.rebuilds;
+    s.cache.group_bonds_of = s.bond_version;
   }
   std::vector<double> K(s.groups.size(), 0.0);
   auto add = [&](std::int64_t a, std::int64_t b, double k) {
@@ -274,14 +276,14 @@ void update_servo_stiffness(State& s) {
     if (gb >= 0) K[gb] += k;
   };
   const double kn = s.settings.contact.kn;
-  for (std::uint32_t k : s.group_pairs)
+  for (std::uint32_t k : s.cache.group_pairs)
     if (s.pairs.overlap_at(k) > 0) add(s.pairs.a[k], s.pairs.b[k], kn);
   // The same sums as over every pair and bond: the others (one body) add nothing. Every bond adds
   // the same kn + beam_kn to each group it ties, so a group's sum takes that term once per end it
   // holds, in any order: the same additions, without reading the bonds and groups each step.
   const double kb = kn + s.bonds.material.beam_kn;
   for (std::size_t g = 0; g < s.groups.size(); ++g)
-    for (std::uint32_t e = 0; e < s.group_bond_ends[g]; ++e) K[g] += kb;
+    for (std::uint32_t e = 0; e < s.cache.group_bond_ends[g]; ++e) K[g] += kb;
   const WallContacts& wc = s.walls.contacts;
   for (std::size_t k = 0; k < wc.n; ++k) {
     const int g = p.group[wc.particle[k]];
@@ -304,7 +306,7 @@ void sync_lazy(State& s) {
     if (g.lazy && !(g.idle_shift == Vec3{})) {
       const Vec3 d = g.idle_shift;
       for (std::int32_t i : g.members) {
-        if (!s.idle[i]) continue;
+        if (!s.cache.idle[i]) continue;
         p.x[i] += d.x; p.y[i] += d.y; p.z[i] += d.z;
         p.vx[i] = g.velocity.x; p.vy[i] = g.velocity.y; p.vz[i] = g.velocity.z;
       }
@@ -320,8 +322,8 @@ void split_idle(State& s) {
   // The bonds inside lazy groups leave the step first: a member held only by them is idle.
   settle_frozen_bonds(s);
   ParticleStore& p = s.p;
-  s.idle.assign(p.n, 0);
-  const Incidence &inc = s.incidence, &binc = s.bond_incidence;
+  s.cache.idle.assign(p.n, 0);
+  const Incidence &inc = s.incidence, &binc = s.cache.bond_incidence;
   const WallContacts& wc = s.walls.contacts;
   auto acted_on = [&](std::size_t i) {
     if (inc.start[i + 1] > inc.start[i] || binc.start[i + 1] > binc.start[i] || wc.start[i + 1] > wc.start[i])
@@ -338,7 +340,7 @@ void split_idle(State& s) {
         g.busy.push_back(i);
         continue;
       }
-      s.idle[i] = 1;
+      s.cache.idle[i] = 1;
       g.idle_mass += p.mass[i];
       const double dx = p.x[i] - p.x0[i], dy = p.y[i] - p.y0[i], dz = p.z[i] - p.z0[i];
       g.idle_base = std::max(g.idle_base, std::sqrt(dx * dx + dy * dy + dz * dz));
@@ -347,36 +349,36 @@ void split_idle(State& s) {
     }
   }
   const std::size_t blocks = (p.n + kParticleBlock - 1) / kParticleBlock;
-  s.block_free.assign(blocks, 0);
+  s.cache.block_free.assign(blocks, 0);
   for (std::size_t i = 0; i < p.n; ++i)
-    if (p.group[i] < 0) s.block_free[i / kParticleBlock] = 1;
-  Incidence& bb = s.block_busy;
+    if (p.group[i] < 0) s.cache.block_free[i / kParticleBlock] = 1;
+  Incidence& bb = s.cache.block_busy;
   bb.start.assign(blocks + 1, 0);
   bb.entry.clear();
   for (std::size_t blk = 0; blk < blocks; ++blk) {
-    if (!s.block_free[blk])
+    if (!s.cache.block_free[blk])
       for (std::size_t i = blk * kParticleBlock; i < std::min(p.n, (blk + 1) * kParticleBlock); ++i)
-        if (!p.inert[i] && !s.idle[i]) bb.entry.push_back(std::int64_t(i));
+        if (!p.inert[i] && !s.cache.idle[i]) bb.entry.push_back(std::int64_t(i));
     bb.start[blk + 1] = std::int32_t(bb.entry.size());
   }
   // The members the group stages move each step (busy ones of lazy groups, all of the others),
   // in slots by group and member order, and the slots by particle block (group_stages).
-  s.moved_particle.clear();
-  s.moved_start.assign(s.groups.size() + 1, 0);
+  s.ctx.moved_particle.clear();
+  s.ctx.moved_start.assign(s.groups.size() + 1, 0);
   for (std::size_t g = 0; g < s.groups.size(); ++g) {
     const Group& grp = s.groups[g];
-    for (std::int32_t i : grp.lazy ? grp.busy : grp.members) s.moved_particle.push_back(i);
-    s.moved_start[g + 1] = s.moved_particle.size();
+    for (std::int32_t i : grp.lazy ? grp.busy : grp.members) s.ctx.moved_particle.push_back(i);
+    s.ctx.moved_start[g + 1] = s.ctx.moved_particle.size();
   }
-  Incidence& bm = s.block_moved;
+  Incidence& bm = s.ctx.block_moved;
   bm.start.assign(blocks + 1, 0);
-  for (std::int32_t i : s.moved_particle) ++bm.start[std::size_t(i) / kParticleBlock + 1];
+  for (std::int32_t i : s.ctx.moved_particle) ++bm.start[std::size_t(i) / kParticleBlock + 1];
   for (std::size_t blk = 0; blk < blocks; ++blk) bm.start[blk + 1] += bm.start[blk];
-  bm.entry.assign(s.moved_particle.size(), 0);
+  bm.entry.assign(s.ctx.moved_particle.size(), 0);
   std::vector<std::int32_t> fill(bm.start.begin(), bm.start.end() - 1);
-  for (std::size_t slot = 0; slot < s.moved_particle.size(); ++slot)
-    bm.entry[std::size_t(fill[std::size_t(s.moved_particle[slot]) / kParticleBlock]++)] = std::int64_t(slot);
-  s.idle_valid = true;
+  for (std::size_t slot = 0; slot < s.ctx.moved_particle.size(); ++slot)
+    bm.entry[std::size_t(fill[std::size_t(s.ctx.moved_particle[slot]) / kParticleBlock]++)] = std::int64_t(slot);
+  s.cache.idle_valid = true;
 }
 
 }  // namespace asperity::detail

@@ -16,8 +16,11 @@
 #include <type_traits>
 
 #include "asperity/io.hpp"
+#include "bodies/groups.hpp"
 #include "bodies/mesh.hpp"
 #include "io/hdf5_file.hpp"
+#include "kernels/bonds.hpp"
+#include "neighbor/build.hpp"
 #include "state.hpp"
 
 namespace asperity {
@@ -580,7 +583,7 @@ World World::load(const std::string& path, int threads, const std::string& simd)
   validate(s, path);
   s.settings.threads = threads;
   s.settings.simd = simd;
-  s.kernels = &kernels::select_kernels(simd);
+  s.ctx.kernels = &kernels::select_kernels(simd);
   // Derived data, rebuilt deterministically.
   s.p.capacity = s.p.x.size();
   for (auto& mesh : s.walls.meshes) detail::bin_mesh(mesh);

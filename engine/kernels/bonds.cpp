@@ -5,6 +5,8 @@
 #include <cmath>
 
 #include "kernels/bond_law.hpp"
+#include "kernels/bonds.hpp"
+#include "neighbor/build.hpp"
 #include "state.hpp"
 
 namespace asperity::detail {
@@ -53,21 +55,6 @@ BondEnergy bond_energy(const State& s, std::size_t k) {
 }
 }  // namespace
 
-void build_incidence(std::size_t particles, const std::int64_t* a, const std::int64_t* b,
-                     std::size_t count, Incidence& inc) {
-  inc.start.assign(particles + 1, 0);
-  for (std::size_t k = 0; k < count; ++k) {
-    ++inc.start[a[k] + 1];
-    ++inc.start[b[k] + 1];
-  }
-  for (std::size_t i = 0; i < particles; ++i) inc.start[i + 1] += inc.start[i];
-  inc.entry.resize(2 * count);
-  std::vector<std::int32_t> fill(inc.start.begin(), inc.start.end() - 1);
-  // Entries as b first: their a < the particle, so they precede its own a-pairs in the sorted
-  // list; each run is ascending, so every particle's entries are in ascending order.
-  for (std::size_t k = 0; k < count; ++k) inc.entry[fill[b[k]]++] = std::int64_t(k) << 1 | 1;
-  for (std::size_t k = 0; k < count; ++k) inc.entry[fill[a[k]]++] = std::int64_t(k) << 1;
-}
 
 void refresh_bond_topology(State& s) {
   ParticleStore& p = s.p;
@@ -75,31 +62,31 @@ void refresh_bond_topology(State& s) {
   q.fill_padding(p.null_a(), p.null_b());
   s.frozen_bonds.fill_padding(p.null_a(), p.null_b());
   ++s.bond_version;
-  s.spin_known = false;  // the bonded particles changed (State::spin_known)
+  s.cache.spin_known = false;  // the bonded particles changed (State::spin_known)
   // The gather's incidence: the bonds the step computes. Partners and rotation locks: every bond
   // (a frozen one still ties its particles).
-  build_incidence(p.n, q.a.data(), q.b.data(), q.n, s.bond_incidence);
-  s.partner_start.assign(p.n + 1, 0);
+  build_incidence(p.n, q.a.data(), q.b.data(), q.n, s.cache.bond_incidence);
+  s.cache.partner_start.assign(p.n + 1, 0);
   for_each_bond(s, [&](const BondStore& b, std::size_t k) {
-    ++s.partner_start[b.a[k] + 1];
-    ++s.partner_start[b.b[k] + 1];
+    ++s.cache.partner_start[b.a[k] + 1];
+    ++s.cache.partner_start[b.b[k] + 1];
   });
-  for (std::size_t i = 0; i < p.n; ++i) s.partner_start[i + 1] += s.partner_start[i];
-  s.partners.resize(std::size_t(s.partner_start[p.n]));
-  std::vector<std::int32_t> fill(s.partner_start.begin(), s.partner_start.end() - 1);
+  for (std::size_t i = 0; i < p.n; ++i) s.cache.partner_start[i + 1] += s.cache.partner_start[i];
+  s.cache.partners.resize(std::size_t(s.cache.partner_start[p.n]));
+  std::vector<std::int32_t> fill(s.cache.partner_start.begin(), s.cache.partner_start.end() - 1);
   for_each_bond(s, [&](const BondStore& b, std::size_t k) {
-    s.partners[fill[b.a[k]]++] = std::int32_t(b.b[k]);
-    s.partners[fill[b.b[k]]++] = std::int32_t(b.a[k]);
+    s.cache.partners[fill[b.a[k]]++] = std::int32_t(b.b[k]);
+    s.cache.partners[fill[b.b[k]]++] = std::int32_t(b.a[k]);
   });
   for (std::size_t i = 0; i < p.n; ++i)
-    std::sort(s.partners.begin() + s.partner_start[i], s.partners.begin() + s.partner_start[i + 1]);
-  s.bonded_particles.clear();  // what the bond stage reads: the ends of the bonds it computes
+    std::sort(s.cache.partners.begin() + s.cache.partner_start[i], s.cache.partners.begin() + s.cache.partner_start[i + 1]);
+  s.cache.bonded_particles.clear();  // what the bond stage reads: the ends of the bonds it computes
   for (std::size_t i = 0; i < p.n; ++i)
-    if (s.bond_incidence.start[i + 1] > s.bond_incidence.start[i]) s.bonded_particles.push_back(std::int32_t(i));
+    if (s.cache.bond_incidence.start[i + 1] > s.cache.bond_incidence.start[i]) s.cache.bonded_particles.push_back(std::int32_t(i));
   // Beam moments: new bonds start without one, and a checkpoint or a break may bring back some.
-  s.bond_moments_zero = true;
-  for (std::size_t k = 0; k < q.n && s.bond_moments_zero; ++k)
-    s.bond_moments_zero = q.mbn[k] == 0 && q.mbsx[k] == 0 && q.mbsy[k] == 0 && q.mbsz[k] == 0;
+  s.cache.bond_moments_zero = true;
+  for (std::size_t k = 0; k < q.n && s.cache.bond_moments_zero; ++k)
+    s.cache.bond_moments_zero = q.mbn[k] == 0 && q.mbsx[k] == 0 && q.mbsy[k] == 0 && q.mbsz[k] == 0;
   // Rotation locks [thesis 3.3]: "restricting the particle rotation when they are bonded together";
   // how far the restriction goes is the calibration's choice (model.md 2). A particle none of whose
   // bonds has broken does not rotate; a damaged one stays locked while it holds rotation_lock_bonds
@@ -108,7 +95,7 @@ void refresh_bond_topology(State& s) {
   // particle with few bonds, as on a joint's face, stays locked until it is damaged.
   s.any_rotating = false;
   for (std::size_t i = 0; i < p.n; ++i) {
-    const std::int64_t intact = s.partner_start[i + 1] - s.partner_start[i];
+    const std::int64_t intact = s.cache.partner_start[i + 1] - s.cache.partner_start[i];
     const std::int64_t needed = std::min<std::int64_t>(s.settings.rotation_lock_bonds, intact + p.bonds_broken[i]);
     const bool bonded = intact >= 1 && intact >= needed;
     const bool locked = !s.settings.rotation || p.user_rotation_locked[i] ||
@@ -187,13 +174,13 @@ StageLoop bond_stage(State& s) {
   // w = +0 only in the sign of an exact zero, bond_law.hpp). It skips six loads and every spin
   // term of the law, which a bonded specimen would otherwise pay at every step for zeros.
   bool spin = s.any_rotating;
-  if (spin && s.spin_known) {
+  if (spin && s.cache.spin_known) {
     // What the last step left for the particles holding a bond (State::spin_known).
-    spin = s.spin_bonded != 0;
+    spin = s.cache.spin_bonded != 0;
   } else if (spin) {
     const ParticleStore& p = s.p;
     spin = false;
-    for (const std::int32_t i : s.bonded_particles)
+    for (const std::int32_t i : s.cache.bonded_particles)
       if (p.spin_bits(std::size_t(i))) {
         spin = true;
         break;
@@ -203,22 +190,22 @@ StageLoop bond_stage(State& s) {
   // particles never turned: the joints) the kernel leaves the four moment columns alone and its
   // records carry no moment, memory traffic saved at every step. A step with spin may give them
   // values.
-  const auto kernel = spin ? s.kernels->bond
-                           : (s.bond_moments_zero ? s.kernels->bond_no_moment : s.kernels->bond_norot);
-  if (spin) s.bond_moments_zero = false;
-  s.bond_records_with_moments = kernel != s.kernels->bond_no_moment;
+  const auto kernel = spin ? s.ctx.kernels->bond
+                           : (s.cache.bond_moments_zero ? s.ctx.kernels->bond_no_moment : s.ctx.kernels->bond_norot);
+  if (spin) s.cache.bond_moments_zero = false;
+  s.cache.bond_records_with_moments = kernel != s.ctx.kernels->bond_no_moment;
   const std::size_t total = s.bonds.padded;
   const std::size_t block = pair_block_size(total);
   st.blocks = (total + block - 1) / block;
   // The kernel writes a break flag only where a bond breaks: flags of a step whose breaks were
   // never processed (it stopped before process_breaks) are cleared, not carried into this one.
-  for (const double b : s.bond_block_breaks)
+  for (const double b : s.ctx.bond_block_breaks)
     if (b != 0) {
       std::fill(s.bonds.broken.begin(), s.bonds.broken.end(), 0.0);
       break;
     }
-  s.bond_block_breaks.assign(st.blocks, 0.0);
-  double* breaks = s.bond_block_breaks.data();
+  s.ctx.bond_block_breaks.assign(st.blocks, 0.0);
+  double* breaks = s.ctx.bond_block_breaks.data();
   st.run = [=](std::size_t blk) {
     const std::size_t begin = blk * block;
     breaks[blk] = kernel(args, begin, std::min(total, begin + block));
@@ -229,8 +216,8 @@ StageLoop bond_stage(State& s) {
 void process_breaks(State& s) {
   BondStore& q = s.bonds;
   double any = 0;
-  for (double b : s.bond_block_breaks) any += b;
-  s.bond_block_breaks.clear();
+  for (double b : s.ctx.bond_block_breaks) any += b;
+  s.ctx.bond_block_breaks.clear();
   if (any == 0) return;
   const ParticleStore& p = s.p;
   BondStore kept;

@@ -15,6 +15,7 @@
 // same).
 #include <cmath>
 
+#include "kernels/integrate.hpp"
 #include "state.hpp"
 
 namespace asperity::detail {
@@ -25,17 +26,17 @@ StageLoop integrate_stage(State& s) {
   const Incidence& inc = s.incidence;
   const WallContacts& wc = s.walls.contacts;
   const BondStore& bq = s.bonds;
-  const Incidence& binc = s.bond_incidence;
+  const Incidence& binc = s.cache.bond_incidence;
   const std::size_t n = p.n;
   const std::size_t blocks = (n + kParticleBlock - 1) / kParticleBlock;
-  s.particle_blocks.assign(blocks, {});
+  s.ctx.particle_blocks.assign(blocks, {});
   const Vec3 g = s.settings.gravity;
   const bool applied = p.has_applied;
-  const std::uint8_t* idle = s.idle.data();  // sized p.n by split_idle, which runs before, as are
+  const std::uint8_t* idle = s.cache.idle.data();  // sized p.n by split_idle, which runs before, as are
                                              // block_free and block_busy
   // Blocks in which no particle spins take the kernel without rotation (below).
-  const auto integrate = s.any_rotating ? s.kernels->integrate : s.kernels->integrate_norot;
-  const auto integrate_norot = s.kernels->integrate_norot;
+  const auto integrate = s.any_rotating ? s.ctx.kernels->integrate : s.ctx.kernels->integrate_norot;
+  const auto integrate_norot = s.ctx.kernels->integrate_norot;
   const kernels::IntegrateArgs args{
       p.x.data(), p.y.data(), p.z.data(), p.vx.data(), p.vy.data(), p.vz.data(),
       p.wx.data(), p.wy.data(), p.wz.data(), p.fx.data(), p.fy.data(), p.fz.data(),
@@ -47,7 +48,7 @@ StageLoop integrate_stage(State& s) {
 
   // The pair sums and the bond terms of a range of particles, in one pass (the kernel skips inert
   // and idle ones, as below).
-  const auto gather_records = s.kernels->gather;
+  const auto gather_records = s.ctx.kernels->gather;
   kernels::GatherArgs pair_args{inc.start.data(), inc.entry.data(), q.out.data(),
                                 p.radius.data(), p.inert.data(), idle, p.fx.data(),
                                 p.fy.data(), p.fz.data(), p.tx.data(), p.ty.data(),
@@ -60,7 +61,7 @@ StageLoop integrate_stage(State& s) {
   bond_args.start = binc.start.data();
   bond_args.entry = binc.entry.data();
   bond_args.records = bq.out.data();
-  bond_args.moments = s.bond_records_with_moments;
+  bond_args.moments = s.cache.bond_records_with_moments;
   // Records past the caches are prefetched a few particles ahead, as the incidences reach their
   // lines out of order; records in cache are not (the prefetches would cost and hide nothing).
   pair_args.prefetch = records_past_caches(q.out);
@@ -116,9 +117,9 @@ StageLoop integrate_stage(State& s) {
   // change until it is cleared, so nothing is read then (the lattice, where both say so).
   const ParticleStore* const ps = &p;
   const std::int32_t* bond_start = binc.start.size() > n ? binc.start.data() : nullptr;
-  const bool full = !s.spin_known;  // bookkeep starts the answer afresh then
+  const bool full = !s.cache.spin_known;  // bookkeep starts the answer afresh then
   const bool track =
-      s.any_rotating && (full || s.spin_reachable == 0 || (bq.n > 0 && s.spin_bonded == 0));
+      s.any_rotating && (full || s.cache.spin_reachable == 0 || (bq.n > 0 && s.cache.spin_bonded == 0));
   auto spin_of = [=](std::size_t first, std::size_t end, ParticleBlockResult& r) {
     // Branch-free (all-ones masks), so that the loops vectorise.
     auto bits = [=](std::size_t i) { return ps->spin_bits(i); };
@@ -141,13 +142,13 @@ StageLoop integrate_stage(State& s) {
   st.after_barrier = true;  // the forces of every stage before it are needed
   st.run = [=, &s](std::size_t blk) {
     ParticleBlockResult r;
-    if (!s.block_free[blk]) {
+    if (!s.cache.block_free[blk]) {
       // Rigid-group members only: their forces feed the group sums; nothing to integrate, and
       // only the busy members (split_idle) have any.
-      for (std::int32_t e = s.block_busy.start[blk]; e < s.block_busy.start[blk + 1]; ++e)
-        gather(std::size_t(s.block_busy.entry[e]));
+      for (std::int32_t e = s.cache.block_busy.start[blk]; e < s.cache.block_busy.start[blk + 1]; ++e)
+        gather(std::size_t(s.cache.block_busy.entry[e]));
       if (track && full) spin_of(blk * kParticleBlock, std::min(n, (blk + 1) * kParticleBlock), r);
-      s.particle_blocks[blk] = r;
+      s.ctx.particle_blocks[blk] = r;
       return;
     }
     const std::size_t first = blk * kParticleBlock;
@@ -192,7 +193,7 @@ StageLoop integrate_stage(State& s) {
     r.worst_step = sums.worst_step;
     r.worst = std::int32_t(sums.worst);
     if (track && (full || spins)) spin_of(first, end, r);
-    s.particle_blocks[blk] = r;
+    s.ctx.particle_blocks[blk] = r;
   };
   return st;
 }

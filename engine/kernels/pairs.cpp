@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "core/cache.hpp"
+#include "kernels/pairs.hpp"
 #include "state.hpp"
 
 namespace asperity::detail {
@@ -33,7 +34,7 @@ namespace {
 // - eight lanes (AVX-512): past a third of the last-level cache on one thread, past the whole of
 //   it on two or more, where the cores' private caches hold more of the step.
 bool stream_pair_records(const State& s) {
-  if (s.kernels->lanes != 8) return records_past_caches(s.pairs.out);
+  if (s.ctx.kernels->lanes != 8) return records_past_caches(s.pairs.out);
   const std::size_t bytes = s.pairs.out.size() * sizeof(double);
   const std::size_t cache = last_level_cache_bytes();
   return thread_count(s) > 1 ? bytes > cache : bytes > cache / 3;
@@ -54,7 +55,7 @@ bool stream_pair_records(const State& s) {
 bool pairs_can_spin(const State& s) {
   if (!s.any_rotating) return false;
   // What the last step left (State::spin_known): the particles a pair can reach, or more.
-  if (s.spin_known) return s.spin_reachable != 0;
+  if (s.cache.spin_known) return s.cache.spin_reachable != 0;
   const ParticleStore& p = s.p;
   const PairStore& q = s.pairs;
   if (4 * q.n < p.n) {
@@ -80,7 +81,7 @@ bool pairs_can_spin(const State& s) {
 StageLoop pair_stage(State& s) {
   auto args = pair_kernel_args(s);
   args.stream = stream_pair_records(s);
-  const auto kernel = pairs_can_spin(s) ? s.kernels->pair : s.kernels->pair_norot;
+  const auto kernel = pairs_can_spin(s) ? s.ctx.kernels->pair : s.ctx.kernels->pair_norot;
   // Live flags (PairKernelArgs::live) where most records are dead, so that the gather skips those
   // (GatherArgs::live): a bonded specimen's pairs are near misses whose particles are bonded
   // elsewhere (a joint in mid-shear: a few per cent live), each a record line read per
@@ -91,9 +92,9 @@ StageLoop pair_stage(State& s) {
   if (q.live_current) {
     std::size_t live = 0;
     for (const std::uint8_t t : q.touched) live += t;
-    s.pair_records_sparse = 2 * live < q.n;
+    s.cache.pair_records_sparse = 2 * live < q.n;
   }
-  q.live_written = s.pair_records_sparse || s.step % 64 == 0;
+  q.live_written = s.cache.pair_records_sparse || s.step % 64 == 0;
   if (!q.live_written) args.live = nullptr;
   // A batch of pairs dead in the last step and in this one keeps its records instead of writing
   // the same zeros again: only where the flags are the last step's.
@@ -104,8 +105,8 @@ StageLoop pair_stage(State& s) {
   StageLoop st;
   const std::size_t block = pair_block_size(total);
   st.blocks = (total + block - 1) / block;
-  s.pair_block_slip.assign(st.blocks, 0.0);
-  double* slip = s.pair_block_slip.data();
+  s.ctx.pair_block_slip.assign(st.blocks, 0.0);
+  double* slip = s.ctx.pair_block_slip.data();
   st.run = [=](std::size_t blk) {
     const std::size_t begin = blk * block;
     slip[blk] = kernel(args, begin, std::min(total, begin + block));

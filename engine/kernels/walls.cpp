@@ -9,6 +9,7 @@
 
 #include "bodies/mesh.hpp"
 #include "kernels/contact_law.hpp"
+#include "kernels/walls.hpp"
 #include "state.hpp"
 
 namespace asperity::detail {
@@ -157,10 +158,10 @@ StageLoop wall_stage(State& s) {
       sums->vy.data(), sums->vz.data(), sums->kn.data(), sums->ks.data(),
       sums->friction.data(), s.dt, nw};
   const bool rot = s.any_rotating;
-  const auto plane_kernel = rot ? s.kernels->plane_walls : s.kernels->plane_walls_norot;
+  const auto plane_kernel = rot ? s.ctx.kernels->plane_walls : s.ctx.kernels->plane_walls_norot;
   const auto plane_tail = rot ? kernels::scalar_kernels().plane_walls
                               : kernels::scalar_kernels().plane_walls_norot;
-  const std::size_t lanes = s.kernels->lanes;
+  const std::size_t lanes = s.ctx.kernels->lanes;
   const bool any_prefetch = std::find(sums->prefetch.begin(), sums->prefetch.end(), 1) != sums->prefetch.end();
   st.run = [&s, nw, sums, plane_args, plane_kernel, plane_tail, lanes, rot, any_prefetch](std::size_t blk) {
     ParticleStore& p = s.p;

@@ -30,8 +30,12 @@
 #include <cmath>
 #include <numeric>
 
+#include "bodies/groups.hpp"
 #include "bodies/mesh.hpp"
+#include "kernels/bonds.hpp"
+#include "neighbor/build.hpp"
 #include "state.hpp"
+#include "step.hpp"
 
 namespace asperity::detail {
 
@@ -290,9 +294,9 @@ void reorder(State& s, const CellGrid& g) {
 }
 
 inline bool bonded(const State& s, std::size_t i, std::int32_t o) {
-  if (s.partners.empty()) return false;
-  const auto first = s.partners.begin() + s.partner_start[i];
-  const auto last = s.partners.begin() + s.partner_start[i + 1];
+  if (s.cache.partners.empty()) return false;
+  const auto first = s.cache.partners.begin() + s.cache.partner_start[i];
+  const auto last = s.cache.partners.begin() + s.cache.partner_start[i + 1];
   return first != last && std::binary_search(first, last, o);
 }
 
@@ -502,6 +506,22 @@ void build_neighbors(State& s) {
   split_idle(s);
 }
 
+void build_incidence(std::size_t particles, const std::int64_t* a, const std::int64_t* b,
+                     std::size_t count, Incidence& inc) {
+  inc.start.assign(particles + 1, 0);
+  for (std::size_t k = 0; k < count; ++k) {
+    ++inc.start[a[k] + 1];
+    ++inc.start[b[k] + 1];
+  }
+  for (std::size_t i = 0; i < particles; ++i) inc.start[i + 1] += inc.start[i];
+  inc.entry.resize(2 * count);
+  std::vector<std::int32_t> fill(inc.start.begin(), inc.start.end() - 1);
+  // Entries as b first: their a < the particle, so they precede its own a-pairs in the sorted
+  // list; each run is ascending, so every particle's entries are in ascending order.
+  for (std::size_t k = 0; k < count; ++k) inc.entry[fill[b[k]]++] = std::int64_t(k) << 1 | 1;
+  for (std::size_t k = 0; k < count; ++k) inc.entry[fill[a[k]]++] = std::int64_t(k) << 1;
+}
+
 double start_pair(PairStore& q, std::size_t k, const ParticleStore& p) {
   const auto a = q.a[k], b = q.b[k];
   const double dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];
@@ -532,8 +552,8 @@ void insert_pairs(State& s, const PairStore& add) {
   merged.fill_padding(s.p.null_a(), s.p.null_b());
   s.pairs = std::move(merged);
   build_incidence(s.p.n, s.pairs.a.data(), s.pairs.b.data(), s.pairs.n, s.incidence);
-  s.group_pairs_at = ~std::uint64_t(0);  // the servo's list holds pair indices
-  s.idle_valid = false;                  // a member may have a pair now
+  s.cache.group_pairs_at = ~std::uint64_t(0);  // the servo's list holds pair indices
+  s.cache.idle_valid = false;                  // a member may have a pair now
 }
 
 }  // namespace asperity::detail

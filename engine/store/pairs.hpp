@@ -4,7 +4,7 @@
 // gather, one record per pair with the pair's force on b and n x Fs, which the SIMD kernel
 // computes eight pairs at a time instead of the scalar gather computing them once per side.
 // The pair kernel leaves the normal force and the overlap in the record too, not in their
-// columns (two stores a pair fewer: perf/README.md); read them with normal_force(k) and
+// columns (two stores a pair fewer in the hottest loop); read them with normal_force(k) and
 // overlap_at(k), which know where they are.
 //
 // Sign convention (model.md 4): n points from a to b; fn, fs act on b; -(fn n + fs) acts on a.
@@ -41,8 +41,8 @@ struct PairStore {
   // The gather's record of pair k: out[kPairRecord k + j], j = 0..7: fx fy fz U cx cy cz fn, the
   // force on b fn n + fs (on a: its negative), the overlap, n x fs (the torque on either
   // particle is -(R - U/2) times it) and the normal force. One 64-byte line per pair: the gather
-  // reaches a pair through the incidence list in one line instead of seven columns
-  // (perf/README.md). Outputs of the step: not carried by rebuilds nor saved.
+  // reaches a pair through the incidence list in one line instead of seven columns. Outputs of
+  // the step: not carried by rebuilds nor saved.
   AVec<double> out;
   // Per stage of kTouchStage pairs: how many of its records the last pair stage found live
   // (kernels.hpp, PairKernelArgs::touched); 1 where not known. Chooses how the kernel computes

@@ -39,10 +39,9 @@ struct Mesh {
   std::vector<std::int32_t> edge_neighbour;
   TriangleBins bins;
 
-  // Its arrays past the caches (4 MB, as records_past_caches in state.hpp): a thesis-scale mould
-  // of 365 x 365 nodes holds ~10 MB, the 2 cm one ~0.4 MB. The wall stage then prefetches the
-  // triangles of the contacts it will evaluate, which cost 0.93 of the packing step at thesis
-  // scale and would cost 1.17 in cache (kernels/walls.cpp, perf/README.md).
+  // Its arrays past the caches (4 MB, as records_past_caches in state.hpp; a thesis-scale mould
+  // is, a 2 cm one is not). The wall stage then prefetches the triangles of the contacts it will
+  // evaluate, which pays only where they do not stay in cache (kernels/walls.cpp).
   bool past_caches() const {
     const std::size_t bytes = vertices.size() * sizeof(Vec3) + triangles.size() * sizeof(triangles[0]) +
                               owns.size() + (vertex_start.size() + vertex_triangles.size() + edge_neighbour.size()) * sizeof(std::int32_t);

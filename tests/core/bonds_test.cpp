@@ -228,7 +228,7 @@ TEST(Bonds, FlagsOfUnprocessedBreaksAreClearedNotCarried) {
   ASSERT_EQ(s.bonds.n, 1u);
   EXPECT_EQ(s.bonds.broken[0], 0.0);
   s.bonds.broken[0] = 1;              // as a kernel would have flagged it ...
-  s.bond_block_breaks.assign(1, 1.0);  // ... in a step whose breaks were never processed
+  s.ctx.bond_block_breaks.assign(1, 1.0);  // ... in a step whose breaks were never processed
   p.w.cycle(1);
   EXPECT_EQ(p.w.bond_count(), 1u) << "the bond holds: nothing pulls on it";
   EXPECT_EQ(s.bonds.broken[0], 0.0) << "the stale flag is gone";

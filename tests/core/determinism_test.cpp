@@ -18,6 +18,7 @@
 #include "kernels/kernels.hpp"
 #include "kernels/pair_loop.hpp"
 #include "scenes.hpp"
+#include "neighbor/build.hpp"
 #include "state.hpp"
 
 using namespace asperity;
@@ -151,16 +152,16 @@ TEST(Determinism, PlatensMovedInTheParallelRegionAreTheSameOnOneAndTwoThreads) {
 // (161 pairs) and small scenes do not; a set count always wins.
 TEST(Determinism, AutomaticThreadCountFollowsTheWork) {
   detail::State s;
-  s.max_threads = 8;
+  s.ctx.max_threads = 8;
   s.p.n = 3972;
   s.pairs.n = 161;
   EXPECT_EQ(detail::thread_count(s), 1);
   s.pairs.n = 4031;
   s.bonds.n = 9098;
   EXPECT_EQ(detail::thread_count(s), 3);
-  s.max_threads = 2;
+  s.ctx.max_threads = 2;
   EXPECT_EQ(detail::thread_count(s), 2);
-  s.max_threads = 8;
+  s.ctx.max_threads = 8;
   s.pairs.n = 30496;  // lattice n = 22
   s.bonds.n = 0;
   EXPECT_EQ(detail::thread_count(s), 4);
@@ -921,7 +922,7 @@ TEST(Determinism, SkippingDeadPairRecordsLeavesARunBitwiseTheSame) {
     Result r;
     for (int k = 0; k < 2000; ++k) {
       if (mode > 0) {
-        w.state().pair_records_sparse = mode == 1;
+        w.state().cache.pair_records_sparse = mode == 1;
         w.state().pairs.live_current = false;
       }
       w.cycle(1);
@@ -1022,13 +1023,13 @@ TEST(Determinism, SpinTakenFromTheLastStepEqualsAScanEveryStep) {
       if (k == 400) {
         for (World* w : {&a, &b}) ASSERT_GT(w->install_bonds(bm, 1e-4, even), 50u);
       }
-      b.state().spin_known = false;  // the twin scans
+      b.state().cache.spin_known = false;  // the twin scans
       a.cycle(1);
       b.cycle(1);
       const auto& s = a.state();
-      ASSERT_TRUE(s.spin_known);
-      (s.spin_reachable == 0 ? still : turning) += 1;
-      if (k >= 400) (s.spin_bonded == 0 ? bonds_still : bonds_turning) += s.spin_reachable != 0;
+      ASSERT_TRUE(s.cache.spin_known);
+      (s.cache.spin_reachable == 0 ? still : turning) += 1;
+      if (k >= 400) (s.cache.spin_bonded == 0 ? bonds_still : bonds_turning) += s.cache.spin_reachable != 0;
     }
     EXPECT_GT(still, 0) << "the run starts without spin";
     EXPECT_GT(turning, 0) << "and the contacts make the spheres turn";
@@ -1077,12 +1078,12 @@ TEST(Determinism, SpinOfRigidGroupMembersReachesThePairStage) {
   };
   World x = make(), y = make();
   for (int k = 0; k < 300; ++k) {
-    y.state().spin_known = false;
+    y.state().cache.spin_known = false;
     x.cycle(1);
     y.cycle(1);
   }
-  ASSERT_TRUE(x.state().spin_known);
-  EXPECT_NE(x.state().spin_reachable, 0u) << "the members spin";
+  ASSERT_TRUE(x.state().cache.spin_known);
+  EXPECT_NE(x.state().cache.spin_reachable, 0u) << "the members spin";
   EXPECT_GT(x.contact_count(), 100u);
   expect_same_run(x, y);
 }

@@ -7,6 +7,7 @@
 
 #include "core/load.hpp"
 #include "state.hpp"
+#include "step.hpp"
 
 namespace asperity::detail {
 namespace {
@@ -106,20 +107,20 @@ TEST(Load, UnreadableClocksLeaveTheCountAlone) {
 
 TEST(Load, AutomaticThreadsFollowTheLimitFixedOnesDoNot) {
   State s;
-  s.max_threads = 2;
+  s.ctx.max_threads = 2;
   s.p.n = 1000000;  // enough particles for two threads by size
   Script script;
   // Others keep one core busy over the first interval.
   const double t0 = LoadWatch::now();
   script.readings = {reading(t0, 0, 0), reading(t0 + 1, 2, 1)};
   LoadWatch w(script.sampler(), 0.5);
-  s.load = &w;
+  s.ctx.load = &w;
   EXPECT_EQ(thread_count(s), 2);
   watch_load(s);  // the first reading
   EXPECT_EQ(thread_count(s), 2);
   w.limit(LoadWatch::now() + 1);  // the interval passes
   watch_load(s);
-  EXPECT_EQ(s.load_limit, 1);
+  EXPECT_EQ(s.ctx.load_limit, 1);
   EXPECT_EQ(thread_count(s), 1);
   s.settings.threads = 2;  // asked for: given, whatever the load
   EXPECT_EQ(thread_count(s), 2);

@@ -60,7 +60,7 @@ TEST(Robustness, NonFiniteAngularVelocityStopsTheStep) {
   World w = pair_of_spheres();
   w.cycle(1);
   w.state().p.wz[w.state().p.index_of_id[1]] = std::nan("");  // inf is caught as a turn of more than 0.1 rad
-  w.state().spin_known = false;
+  w.state().cache.spin_known = false;
   try {
     w.cycle(5);
     FAIL() << "the step went on";

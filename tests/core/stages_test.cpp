@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "state.hpp"
+#include "step.hpp"
 
 namespace asperity::detail {
 namespace {
@@ -18,7 +19,7 @@ namespace {
 TEST(Stages, EveryBlockRunsOnceAndASlowShareIsTaken) {
   State s;
   s.settings.threads = 2;
-  s.max_threads = 2;
+  s.ctx.max_threads = 2;
   constexpr std::size_t kFirst = 40, kSecond = 13, kThird = 9;
   std::vector<std::atomic<int>> first(kFirst), second(kSecond), third(kThird);
   std::vector<int> first_by(kFirst, -1);

@@ -1,0 +1,21 @@
+// Stage 3 of a step: bond forces and breaks, and the bond list's life between steps
+// (kernels/bonds.cpp).
+#pragma once
+#include "state.hpp"
+
+namespace asperity::detail {
+
+StageLoop bond_stage(State& s);
+kernels::BondKernelArgs bond_kernel_args(State& s);  // its kernel's arguments (perf/ reuses them)
+void process_breaks(State& s);         // events, energy, compaction
+void refresh_bond_topology(State& s);  // incidence, partners, rotation locks
+// Moves the bonds inside lazy groups (Group::lazy, set by the caller) to State::frozen_bonds and
+// the others back; true if any moved (the topology is then refreshed).
+bool settle_frozen_bonds(State& s);
+// Every bond, active and frozen, in one store sorted by (a, b) (checkpoints).
+BondStore all_bonds(const State& s);
+// x and y (each sorted by (a, b), no bond in both) in one store sorted by (a, b); its material
+// and `any` are left to the caller.
+BondStore merge_bonds(const BondStore& x, const BondStore& y);
+
+}  // namespace asperity::detail

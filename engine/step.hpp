@@ -1,0 +1,24 @@
+// One step (step.cpp): the stages in order, the time step, the health checks and the energies.
+#pragma once
+#include <initializer_list>
+
+#include "state.hpp"
+
+namespace asperity::detail {
+
+void step_once(State& s);
+// The loops of several stages in one parallel region, each stage's blocks in order.
+void run_stages(State& s, std::initializer_list<StageLoop*> stages);
+double estimate_critical_dt(const State& s);
+// The deepest contact overlap relative to the radius of the smaller body it joins (a wall counts
+// as infinitely large), over touching pairs, wall contacts and bonds; particle -1 and ratio 0
+// when nothing overlaps.
+struct OverlapRatio {
+  double ratio = 0;
+  std::int64_t particle = -1;
+};
+OverlapRatio deepest_overlap(const State& s);
+Energies compute_energies(const State& s);
+void watch_load(State& s);  // StepContext::load_limit, for automatic threads
+
+}  // namespace asperity::detail
