@@ -62,7 +62,7 @@ int interruption_tostring(lua_State* L) {
   return 1;
 }
 
-// "text " .. err keeps working as it did when the error was a string.
+// "text " .. err works as it does with an error message that is a string.
 int interruption_concat(lua_State* L) {
   luaL_tolstring(L, 1, nullptr);
   luaL_tolstring(L, 2, nullptr);
