@@ -669,7 +669,7 @@ end
 -- Ctrl-C: the runs stop with the runner (their wrappers see it go) and stay NAME.part.
 local ok, err = pcall(run_all)
 if not ok then
-  if tostring(err):find("interrupted") then
+  if asperity.is_interrupted(err) then
     local names = {}
     for name in pairs(running) do names[#names + 1] = name end
     table.sort(names)

@@ -61,6 +61,7 @@ void push_current_exception(lua_State* L) {
     luaL_where(L, 1);
     lua_pushstring(L, e.what());
     lua_concat(L, 2);
+    if (dynamic_cast<const Interrupted*>(&e)) make_interruption(L);
   } catch (...) {
     luaL_where(L, 1);
     lua_pushstring(L, "unknown C++ exception");
@@ -486,6 +487,7 @@ int open_asperity(lua_State* L) {
   open_snapshots(L);
   open_io(L);
   open_surface(L);
+  open_interrupt(L);
   return 1;
 }
 

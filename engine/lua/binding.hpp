@@ -44,7 +44,8 @@ struct ArgError {
 // The error value of a failed lua_pcall is on top of the stack: re-raise it as it is.
 struct PendingLuaError {};
 
-// Raised by world:run/cycle when Ctrl-C stopped the run.
+// Raised by world:run/cycle when Ctrl-C stopped the run; reaches Lua as an interruption
+// (interrupt.hpp), not a string.
 struct Interrupted : Error {
   using Error::Error;
 };
@@ -149,6 +150,7 @@ void open_series(lua_State* L);
 void open_snapshots(lua_State* L);
 void open_io(lua_State* L);
 void open_surface(lua_State* L);  // asperity.surface (wrap_surface.cpp)
+void open_interrupt(lua_State* L);  // asperity.is_interrupted (interrupt.cpp)
 
 // The `asperity` module table, complete (pushed).
 int open_asperity(lua_State* L);

@@ -5,10 +5,13 @@
 #include <csignal>
 
 #include "asperity/world.hpp"
+#include "lua/binding.hpp"
 
 namespace asperity::lua {
 
 namespace {
+constexpr const char* kInterruptedType = "asperity.Interrupted";
+
 std::atomic<World*> running{nullptr};
 std::atomic<lua_State*> state{nullptr};
 std::atomic<bool> run_interrupted{false};
@@ -20,7 +23,11 @@ void interrupt_hook(lua_State* L, lua_Debug*) {
   lua_sethook(L, nullptr, 0, 0);
   run_interrupted = false;
   pending = 0;
-  luaL_error(L, "interrupted");
+  luaL_where(L, 1);
+  lua_pushstring(L, "interrupted");
+  lua_concat(L, 2);
+  make_interruption(L);
+  lua_error(L);
 }
 
 void on_sigint(int) {
@@ -43,6 +50,71 @@ void on_sigint(int) {
     lua_sethook(L, interrupt_hook, LUA_MASKCALL | LUA_MASKRET | LUA_MASKCOUNT, 1);
 }
 }  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// The error value
+
+namespace {
+
+int interruption_tostring(lua_State* L) {
+  luaL_checktype(L, 1, LUA_TTABLE);
+  lua_getfield(L, 1, "message");
+  return 1;
+}
+
+// "text " .. err works as it does with an error message that is a string.
+int interruption_concat(lua_State* L) {
+  luaL_tolstring(L, 1, nullptr);
+  luaL_tolstring(L, 2, nullptr);
+  lua_concat(L, 2);
+  return 1;
+}
+
+void push_interruption_metatable(lua_State* L) {
+  if (luaL_newmetatable(L, kInterruptedType)) {
+    static const luaL_Reg meta[] = {{"__tostring", interruption_tostring},
+                                    {"__concat", interruption_concat},
+                                    {nullptr, nullptr}};
+    luaL_setfuncs(L, meta, 0);
+  }
+}
+
+int l_is_interrupted(lua_State* L) {
+  lua_pushboolean(L, is_interruption(L, 1));
+  return 1;
+}
+
+}  // namespace
+
+void make_interruption(lua_State* L) {
+  lua_createtable(L, 0, 2);
+  lua_insert(L, -2);
+  lua_setfield(L, -2, "message");
+  push_interruption_metatable(L);
+  lua_setmetatable(L, -2);
+}
+
+bool is_interruption(lua_State* L, int index) {
+  if (!lua_getmetatable(L, index)) return false;
+  luaL_getmetatable(L, kInterruptedType);
+  bool same = lua_rawequal(L, -1, -2);
+  lua_pop(L, 2);
+  return same;
+}
+
+void open_interrupt(lua_State* L) {
+  push_interruption_metatable(L);
+  lua_pop(L, 1);
+  static const Function fns[] = {
+      {"is_interrupted", l_is_interrupted, "asperity.is_interrupted(err) -> boolean",
+       "Whether an error value (from pcall) is a Ctrl-C rather than a failure. An interruption\n"
+       "is an error object, not a string: tostring(err) gives its message, \"file:line:\n"
+       "interrupted ...\". A failure whose message says \"interrupted\" is not one."}};
+  register_functions(L, -1, fns);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The signal
 
 void install_interrupt_handler(lua_State* L) {
   state = L;

@@ -1,17 +1,19 @@
-// The interactive loop, after lua.c.
-//
-// - Each input is first tried as `return <input>` so expressions print their value; if that
-//   does not compile, as a statement. Input that is incomplete (the parser stopped at <eof>)
-//   continues on the next line with a ">>" prompt.
-// - Results are printed by the Lua printer of session.cpp (tables one level deep); errors with a
-//   traceback, except Ctrl-C interruptions, which print one line.
-// - With a terminal: GNU readline through its callback interface, driven by select(), because
-//   a signal then interrupts select() (EINTR) and the loop can act on Ctrl-C itself: clear the
-//   line, and exit on a second Ctrl-C in a row. History in ~/.asperity_history; tab completion
-//   of globals, fields and methods (a.b.c, obj:method) read with raw accesses only, so
-//   completing can never run user code or raise.
-// - Without a terminal (a pipe, a test): plain lines, no prompts, results on stdout, errors on
-//   stderr, and the exit status tells whether any chunk failed.
+// The interactive loop, in lua.c's pieces:
+// - read: one line, from a terminal through GNU readline or from a pipe as it is;
+// - compile: `return <input>` first so that expressions print their value, else the input as a
+//   statement; input the parser stopped in at <eof> (incomplete) continues on the next line,
+//   with a ">>" prompt. "=x" is x, as in lua.c;
+// - run: the chunk with the traceback-adding message handler of session.cpp;
+// - print_results: the Lua printer of session.cpp (tables one level deep); report: errors with
+//   their traceback, except Ctrl-C interruptions (told by type, interrupt.hpp), which print
+//   their message alone.
+// With a terminal: readline through its callback interface, driven by select(), because a
+// signal then interrupts select() (EINTR) and the loop can act on Ctrl-C itself: clear the line,
+// and exit on a second Ctrl-C in a row. History in ~/.asperity_history; tab completion of
+// globals, fields and methods (a.b.c, obj:method) read with raw accesses only, so completing can
+// never run user code or raise.
+// Without a terminal (a pipe, a test): plain lines, no prompts, results on stdout, errors on
+// stderr, and the exit status tells whether any chunk failed.
 #include <readline/history.h>
 #include <readline/readline.h>
 #include <sys/select.h>
@@ -25,6 +27,7 @@
 #include <cstring>
 #include <iostream>
 #include <set>
+#include <string_view>
 
 #include "lua/binding.hpp"
 #include "lua/interrupt.hpp"
@@ -37,64 +40,6 @@ int call_with_traceback(lua_State* L, int nargs, int nresults);  // session.cpp
 namespace {
 
 lua_State* completion_state = nullptr;
-
-bool incomplete(lua_State* L, int status) {
-  if (status != LUA_ERRSYNTAX) return false;
-  std::size_t n = 0;
-  const char* msg = lua_tolstring(L, -1, &n);
-  const char eof[] = "<eof>";
-  return msg && n >= sizeof eof - 1 && std::strcmp(msg + n - (sizeof eof - 1), eof) == 0;
-}
-
-enum class Outcome { done, failed, more };
-
-void print_results(lua_State* L, int n) {
-  if (n <= 0) return;
-  lua_getfield(L, LUA_REGISTRYINDEX, "asperity.show");
-  lua_insert(L, -n - 1);
-  if (lua_pcall(L, n, 0, 0) != LUA_OK) {
-    std::fprintf(stderr, "error printing the result: %s\n", lua_tostring(L, -1));
-    lua_pop(L, 1);
-  }
-  std::fflush(stdout);
-}
-
-// Compiles and runs one chunk of input (possibly several lines).
-Outcome evaluate(lua_State* L, const std::string& input) {
-  std::string as_return = "return " + input + ";";
-  int top = lua_gettop(L);
-  int status = luaL_loadbufferx(L, as_return.data(), as_return.size(), "=stdin", "t");
-  bool return_incomplete = false;
-  if (status != LUA_OK) {
-    return_incomplete = incomplete(L, status);
-    lua_pop(L, 1);
-    status = luaL_loadbufferx(L, input.data(), input.size(), "=stdin", "t");
-    if (status != LUA_OK) {
-      // "{1," is not yet a statement but may become an expression: wait for more as well.
-      if (incomplete(L, status) || return_incomplete) {
-        lua_pop(L, 1);
-        return Outcome::more;
-      }
-      std::fprintf(stderr, "%s\n", lua_tostring(L, -1));
-      lua_pop(L, 1);
-      return Outcome::failed;
-    }
-  }
-  clear_interrupts();
-  status = call_with_traceback(L, 0, LUA_MULTRET);
-  if (status != LUA_OK) {
-    const char* msg = lua_tostring(L, -1);
-    std::string text = msg ? msg : "(error object without a message)";
-    // A Ctrl-C is not a bug: the message alone, without the traceback.
-    if (text.find("interrupted") != std::string::npos) text = text.substr(0, text.find('\n'));
-    std::fprintf(stderr, "%s\n", text.c_str());
-    lua_settop(L, top);
-    return Outcome::failed;
-  }
-  print_results(L, lua_gettop(L) - top);
-  lua_settop(L, top);
-  return Outcome::done;
-}
 
 // ---------------------------------------------------------------------------------------------
 // Completion
@@ -267,87 +212,176 @@ std::string history_path() {
   return std::string(home && *home ? home : ".") + "/.asperity_history";
 }
 
-int interactive(Session& session) {
-  lua_State* L = session.state();
-  completion_state = L;
-  rl_readline_name = "asperity";
-  rl_catch_signals = 0;  // our SIGINT handler stays in charge (interrupt.cpp)
-  rl_attempted_completion_function = complete;
-  // '.' and ':' are not word breaks: "asperity.wo<TAB>" completes the whole chain.
-  rl_basic_word_break_characters = const_cast<char*>(" \t\n\"\\'><=;+-*/%^~#&|{}()[],");
-  rl_completion_append_character = '\0';
-  std::string hist = history_path();
-  using_history();
-  stifle_history(2000);
-  // append_history() only appends to an existing file: create it on the first session.
-  if (read_history(hist.c_str()) != 0) write_history(hist.c_str());
-  install_interrupt_handler(L);
+// Where the lines come from: readline with history and completion on a terminal, plain lines
+// from a pipe.
+class Input {
+ public:
+  explicit Input(lua_State* L) : terminal_(::isatty(STDIN_FILENO)) {
+    if (!terminal_) return;
+    completion_state = L;
+    rl_readline_name = "asperity";
+    rl_catch_signals = 0;  // our SIGINT handler stays in charge (interrupt.cpp)
+    rl_attempted_completion_function = complete;
+    // '.' and ':' are not word breaks: "asperity.wo<TAB>" completes the whole chain.
+    rl_basic_word_break_characters = const_cast<char*>(" \t\n\"\\'><=;+-*/%^~#&|{}()[],");
+    rl_completion_append_character = '\0';
+    history_ = history_path();
+    using_history();
+    stifle_history(2000);
+    // append_history() only appends to an existing file: create it on the first session.
+    if (read_history(history_.c_str()) != 0) write_history(history_.c_str());
+  }
+  ~Input() {
+    if (!terminal_) return;
+    history_truncate_file(history_.c_str(), 2000);
+    completion_state = nullptr;
+  }
+  Input(const Input&) = delete;
+  Input& operator=(const Input&) = delete;
 
-  std::printf("%s", version_text().c_str());
-  std::printf("help() lists the API; Ctrl-C stops a run; Ctrl-D (or Ctrl-C twice) exits.\n");
-  std::string buffer;
-  bool last_was_interrupt = false;
+  bool terminal() const { return terminal_; }
+
+  // One line; `prompt` shows on a terminal only, where Ctrl-C gives Read::interrupt.
+  Read read(const char* prompt, std::string& line) {
+    if (terminal_) return read_terminal(prompt, line);
+    return std::getline(std::cin, line) ? Read::line : Read::eof;
+  }
+
+  // A chunk that was run or refused (not one still going on) joins the history.
+  void remember(const std::string& chunk) {
+    if (!terminal_) return;
+    add_history(chunk.c_str());
+    append_history(1, history_.c_str());
+  }
+
+ private:
+  bool terminal_;
+  std::string history_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Compiling, running, printing
+
+int load(lua_State* L, std::string_view code) {
+  return luaL_loadbufferx(L, code.data(), code.size(), "=stdin", "t");
+}
+
+// The parser stopped at the end of the input: more lines may complete it.
+bool incomplete(lua_State* L, int status) {
+  if (status != LUA_ERRSYNTAX) return false;
+  std::size_t n = 0;
+  const char* msg = lua_tolstring(L, -1, &n);
+  const char eof[] = "<eof>";
+  return msg && n >= sizeof eof - 1 && std::strcmp(msg + n - (sizeof eof - 1), eof) == 0;
+}
+
+enum class Compiled { ok, more, error };
+
+// ok: the chunk's function is on the stack; error: its syntax error is; more: nothing is, the
+// chunk may go on on the next line.
+Compiled compile(lua_State* L, std::string_view chunk) {
+  if (chunk.front() == '=') chunk.remove_prefix(1);  // lua.c's "=x": x prints its value anyway
+  int status = load(L, "return " + std::string(chunk) + ";");
+  if (status == LUA_OK) return Compiled::ok;
+  // "{1," is not yet a statement but may become an expression: wait for more as well.
+  bool expression_incomplete = incomplete(L, status);
+  lua_pop(L, 1);
+  status = load(L, chunk);
+  if (status == LUA_OK) return Compiled::ok;
+  if (!incomplete(L, status) && !expression_incomplete) return Compiled::error;
+  lua_pop(L, 1);
+  return Compiled::more;
+}
+
+void print_results(lua_State* L, int n) {
+  if (n <= 0) return;
+  lua_getfield(L, LUA_REGISTRYINDEX, "asperity.show");
+  lua_insert(L, -n - 1);
+  if (lua_pcall(L, n, 0, 0) != LUA_OK) {
+    std::fprintf(stderr, "error printing the result: %s\n", lua_tostring(L, -1));
+    lua_pop(L, 1);
+  }
+  std::fflush(stdout);
+}
+
+// Prints the error value on top of the stack and pops it. A Ctrl-C is not a bug: its message
+// alone, without the traceback.
+void report(lua_State* L) {
+  int value = lua_gettop(L);
+  const char* msg = is_interruption(L, value) ? luaL_tolstring(L, value, nullptr) : lua_tostring(L, value);
+  std::fprintf(stderr, "%s\n", msg ? msg : "(error object without a message)");
+  lua_settop(L, value - 1);
+}
+
+// Runs the function on top of the stack and prints what it returns; false if it failed.
+bool run(lua_State* L) {
+  int base = lua_gettop(L) - 1;
+  clear_interrupts();
+  if (call_with_traceback(L, 0, LUA_MULTRET) != LUA_OK) {
+    report(L);
+    return false;
+  }
+  print_results(L, lua_gettop(L) - base);
+  lua_settop(L, base);
+  return true;
+}
+
+// lua.c's doREPL: read, compile (or read on), run, print, until the input ends.
+int loop(lua_State* L, Input& in) {
+  std::string chunk;
+  bool failed = false, last_was_interrupt = false;
   for (;;) {
     std::string line;
-    Read r = read_terminal(buffer.empty() ? "> " : ">> ", line);
-    if (r == Read::eof) {
-      std::printf("\n");
-      break;
-    }
+    Read r = in.read(chunk.empty() ? "> " : ">> ", line);
     if (r == Read::interrupt) {
       if (last_was_interrupt) break;
       last_was_interrupt = true;
-      buffer.clear();
+      chunk.clear();
       std::printf("(Ctrl-C again to exit)\n");
       continue;
     }
     last_was_interrupt = false;
-    buffer = buffer.empty() ? line : buffer + "\n" + line;
-    if (buffer.find_first_not_of(" \t") == std::string::npos) {
-      buffer.clear();
+    if (r == Read::eof) {
+      if (in.terminal()) {
+        std::printf("\n");
+      } else if (!chunk.empty()) {
+        // Input ended inside a chunk: what the parser says about it.
+        if (load(L, chunk) != LUA_OK) report(L);
+        else lua_pop(L, 1);
+        failed = true;
+      }
+      break;
+    }
+    chunk = chunk.empty() ? line : chunk + "\n" + line;
+    if (chunk.find_first_not_of(" \t\r") == std::string::npos) {
+      chunk.clear();
       continue;
     }
-    Outcome o = evaluate(L, buffer);
-    if (o == Outcome::more) continue;
-    add_history(buffer.c_str());
-    append_history(1, hist.c_str());
-    buffer.clear();
-  }
-  history_truncate_file(hist.c_str(), 2000);
-  completion_state = nullptr;
-  return 0;
-}
-
-int piped(Session& session) {
-  lua_State* L = session.state();
-  install_interrupt_handler(L);
-  std::string buffer, line;
-  bool failed = false;
-  while (std::getline(std::cin, line)) {
-    buffer = buffer.empty() ? line : buffer + "\n" + line;
-    if (buffer.find_first_not_of(" \t\r") == std::string::npos) {
-      buffer.clear();
-      continue;
+    Compiled c = compile(L, chunk);
+    if (c == Compiled::more) continue;
+    in.remember(chunk);
+    if (c == Compiled::ok) {
+      failed = !run(L) || failed;
+    } else {
+      report(L);
+      failed = true;
     }
-    Outcome o = evaluate(L, buffer);
-    if (o == Outcome::more) continue;
-    failed = failed || o == Outcome::failed;
-    buffer.clear();
+    chunk.clear();
   }
-  if (!buffer.empty()) {
-    // Input ended inside a chunk: report what the parser says about it.
-    if (luaL_loadbufferx(L, buffer.data(), buffer.size(), "=stdin", "t") != LUA_OK)
-      std::fprintf(stderr, "%s\n", lua_tostring(L, -1));
-    lua_pop(L, 1);
-    failed = true;
-  }
-  return failed ? 1 : 0;
+  return in.terminal() || !failed ? 0 : 1;
 }
 
 }  // namespace
 
 int repl(Session& session) {
-  return ::isatty(STDIN_FILENO) ? interactive(session) : piped(session);
+  lua_State* L = session.state();
+  Input in(L);
+  install_interrupt_handler(L);
+  if (in.terminal()) {
+    std::printf("%s", version_text().c_str());
+    std::printf("help() lists the API; Ctrl-C stops a run; Ctrl-D (or Ctrl-C twice) exits.\n");
+  }
+  return loop(L, in);
 }
 
 }  // namespace asperity::lua

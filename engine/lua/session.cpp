@@ -123,8 +123,15 @@ int l_doc(lua_State* L) {
   return 1;
 }
 
-// lua.c's message handler: add a traceback to string messages.
+// lua.c's message handler: add a traceback to string messages. An interruption stays the
+// object it is, so that callers tell it by its type, and carries its traceback as a field.
 int message_handler(lua_State* L) {
+  if (is_interruption(L, 1)) {
+    luaL_traceback(L, L, luaL_tolstring(L, 1, nullptr), 1);
+    lua_setfield(L, 1, "traceback");
+    lua_settop(L, 1);
+    return 1;
+  }
   const char* msg = lua_tostring(L, 1);
   if (!msg) {
     if (luaL_callmeta(L, 1, "__tostring") && lua_type(L, -1) == LUA_TSTRING) return 1;
@@ -249,34 +256,31 @@ void Session::set_params(const std::string& script,
 }
 
 bool Session::run_file(const std::string& path, std::string* error) {
-  interrupted_ = false;
   clear_interrupts();
-  if (luaL_loadfilex(L_, path.c_str(), "t") != LUA_OK) {
-    if (error) *error = lua_tostring(L_, -1);
-    lua_pop(L_, 1);
-    return false;
-  }
-  if (traceback_call(L_, 0, 0) != LUA_OK) {
-    const char* msg = lua_tostring(L_, -1);
-    if (error) *error = msg ? msg : "(error object without a message)";
-    interrupted_ = error && error->find("interrupted") != std::string::npos;
-    lua_pop(L_, 1);
-    return false;
-  }
-  return true;
+  int status = luaL_loadfilex(L_, path.c_str(), "t");
+  if (status == LUA_OK) status = traceback_call(L_, 0, 0);
+  return finish(status, error);
 }
 
 bool Session::run_string(const std::string& code, const std::string& chunk_name, std::string* error) {
-  interrupted_ = false;
   clear_interrupts();
-  if (luaL_loadbufferx(L_, code.data(), code.size(), chunk_name.c_str(), "t") != LUA_OK ||
-      traceback_call(L_, 0, 0) != LUA_OK) {
-    const char* msg = lua_tostring(L_, -1);
-    if (error) *error = msg ? msg : "(error object without a message)";
+  int status = luaL_loadbufferx(L_, code.data(), code.size(), chunk_name.c_str(), "t");
+  if (status == LUA_OK) status = traceback_call(L_, 0, 0);
+  return finish(status, error);
+}
+
+bool Session::finish(int status, std::string* error) {
+  interrupted_ = status != LUA_OK && is_interruption(L_, -1);
+  if (status == LUA_OK) return true;
+  int value = lua_gettop(L_);
+  if (interrupted_ && lua_getfield(L_, value, "traceback") != LUA_TSTRING) {
     lua_pop(L_, 1);
-    return false;
+    luaL_tolstring(L_, value, nullptr);
   }
-  return true;
+  const char* msg = lua_tostring(L_, -1);
+  if (error) *error = msg ? msg : "(error object without a message)";
+  lua_settop(L_, value - 1);
+  return false;
 }
 
 // Used by repl.cpp.

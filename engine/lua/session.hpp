@@ -36,10 +36,12 @@ class Session {
   bool run_file(const std::string& path, std::string* error);
   bool run_string(const std::string& code, const std::string& chunk_name, std::string* error);
 
-  // Whether the last failure was a Ctrl-C.
+  // Whether the last failure was a Ctrl-C (an interruption, interrupt.hpp).
   bool interrupted() const { return interrupted_; }
 
  private:
+  // After a load or call with this status: false, with the error's text in *error, on failure.
+  bool finish(int status, std::string* error);
   lua_State* L_;
   bool interrupted_ = false;
 };

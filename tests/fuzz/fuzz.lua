@@ -519,7 +519,7 @@ local function sequence(seed)
     if not ok then
       stats.failed = stats.failed + 1
       if verbose then print(seed, name, err) end
-      if tostring(err):find("interrupted") then error(err) end
+      if asperity.is_interrupted(err) then error(err) end
     end
     -- Every world is checked after every call (a callback or a load may touch another one). A
     -- world may hold non-finite values only after a step stopped with "simulation stopped" (the

@@ -1,5 +1,8 @@
 // The Lua binding seen from C++: a Session runs code; errors come back as messages.
 #include <gtest/gtest.h>
+#include <lua.hpp>
+
+#include <csignal>
 
 #include "lua/session.hpp"
 
@@ -68,6 +71,23 @@ TEST(Binding, CallbackErrorsKeepTheirPosition) {
   EXPECT_NE(error.find("stack traceback"), std::string::npos) << error;
   // the world is still usable after the error
   ok(s, "assert(w:step() == 2); w:cycle(3); assert(w:step() == 5)");
+}
+
+// A Ctrl-C while Lua code runs (the signal raised from inside it, so it comes at a known point):
+// an interruption, told by its type from a plain error that says "interrupted".
+TEST(Binding, InterruptionIsTypedNotWorded) {
+  Session s;
+  lua_register(s.state(), "sigint", [](lua_State*) {
+    std::raise(SIGINT);
+    return 0;
+  });
+  ok(s, "local ok, e = pcall(function() sigint(); return 1 end)\n"
+        "assert(not ok and asperity.is_interrupted(e) and tostring(e) == 'test:1: interrupted', tostring(e))");
+  std::string error = fails(s, "sigint()\nlocal x = 1", "test:1: interrupted\nstack traceback:");
+  EXPECT_TRUE(s.interrupted()) << error;
+  fails(s, "error('interrupted')", "test:1: interrupted");
+  EXPECT_FALSE(s.interrupted());
+  ok(s, "local ok, e = pcall(error, 'interrupted'); assert(not asperity.is_interrupted(e))");
 }
 
 TEST(Binding, ArraysAndVectors) {
