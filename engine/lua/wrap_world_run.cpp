@@ -228,7 +228,7 @@ int world_rebuild_neighbors(lua_State* L) {
 std::span<const Function> world_run_methods() {
   static const Function methods[] = {
       {"cycle", world_cycle, "world:cycle([n]) -> steps",
-       "Advances n steps (1). Ctrl-C stops it at the next step with an 'interrupted' error."},
+       "Advances n steps (1). Ctrl-C stops it at the next step with an interruption (asperity.is_interrupted(err) is true)."},
       {"run", world_run,
        "world:run{steps= [, stop_when=] [, ratio=] [, every=] [, callback=] [, progress=] [, show=]\n"
        "          [, fraction=]}\n"
