@@ -7,7 +7,7 @@
 #include <numbers>
 
 #include "asperity/world.hpp"
-#include "core/report.hpp"
+#include "report.hpp"
 
 using namespace asperity;
 using asperity::test::report;

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "asperity/world.hpp"
-#include "core/report.hpp"
+#include "report.hpp"
 
 using namespace asperity;
 using asperity::test::report;

@@ -6,7 +6,7 @@
 #include <random>
 
 #include "asperity/world.hpp"
-#include "core/report.hpp"
+#include "report.hpp"
 
 using namespace asperity;
 using asperity::test::report;
