@@ -667,23 +667,14 @@ World::ContactStress World::contact_stress(int tag, double volume) const {
 std::size_t World::install_bonds(const BondMaterial& material, double tolerance,
                                  std::span<const std::int64_t> ids, bool stress_free) {
   State& s = *state_;
-  require(material.beam_kn > 0 && std::isfinite(material.beam_kn),
-          "bond material: beam_kn must be > 0, got " + num(material.beam_kn));
-  require(material.beam_ks > 0 && std::isfinite(material.beam_ks),
-          "bond material: beam_ks must be > 0, got " + num(material.beam_ks));
-  require(material.radius_factor > 0 && std::isfinite(material.radius_factor),
-          "bond material: radius_factor must be > 0, got " + num(material.radius_factor));
-  require(!material.breakable || (material.tensile_strength > 0 && std::isfinite(material.tensile_strength)),
+  for_each_field(material, [](const Field& f, const auto& v) { check_value("bond material: ", f, v); });
+  require(!material.breakable || material.tensile_strength > 0,
           "bond material: a breakable bond needs tensile_strength > 0 (Pa), got " +
               num(material.tensile_strength) + "; set breakable = false for unbreakable bonds");
-  if (s.bonds.n + s.frozen_bonds.n > 0) {
-    const BondMaterial& m = s.bonds.material;
-    require(m.beam_kn == material.beam_kn && m.beam_ks == material.beam_ks &&
-                m.radius_factor == material.radius_factor &&
-                m.tensile_strength == material.tensile_strength && m.breakable == material.breakable,
+  if (s.bonds.n + s.frozen_bonds.n > 0)
+    require(s.bonds.material == material,
             "install_bonds: the world already holds bonds of another material (one bond material "
             "per world)");
-  }
   auto& p = s.p;
   require(p.n > 0, "install_bonds: the world has no particles");
   if (tolerance < 0) {

@@ -152,7 +152,10 @@ void visit_value(auto& io, const std::string& at, bool& v) { io.flag(at, v); }
 void visit_value(auto& io, const std::string& at, Vec3& v) { io.vec(at, v); }
 void visit_value(auto&, const std::string&, std::string&) {}  // no text setting is saved
 void visit_value(auto& io, const std::string& at, ContactMaterial& m) {
-  for_each_field(m, [&](const Field& f, double& v) { io.scalar(at + "/" + f.stored, v); });
+  for_each_field(m, [&](const Field& f, auto& v) { visit_value(io, at + "/" + f.stored, v); });
+}
+void visit_value(auto& io, const std::string& at, BondMaterial& m) {
+  for_each_field(m, [&](const Field& f, auto& v) { visit_value(io, at + "/" + f.stored, v); });
 }
 
 template <class Io>
@@ -227,11 +230,7 @@ void visit(Io& io, State& s) {
       [&](const detail::ColumnInfo& c, auto& col) { visit_column(io, "bonds/", c, col, b.padded); }, b);
   if (io.version >= 3) io.flag("bonds/rest_overlaps", s.rest_overlaps);
   b.size_outputs();
-  io.scalar("bonds/material/beam_kn", b.material.beam_kn);
-  io.scalar("bonds/material/beam_ks", b.material.beam_ks);
-  io.scalar("bonds/material/radius_factor", b.material.radius_factor);
-  io.scalar("bonds/material/tensile_strength", b.material.tensile_strength);
-  io.flag("bonds/material/breakable", b.material.breakable);
+  visit_value(io, "bonds/material", b.material);
   io.flag("bonds/any", b.any);
   if constexpr (!std::is_same_v<Io, Writer>) {
     s.frozen_bonds.material = b.material;
@@ -367,9 +366,12 @@ bool setting_valid(const Field&, const std::string&) { return true; }
 bool setting_valid(const Field&, const Vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
-bool setting_valid(const Field&, const ContactMaterial& m) {
+// A material: every field valid.
+template <class Material>
+  requires std::is_same_v<Material, ContactMaterial> || std::is_same_v<Material, BondMaterial>
+bool setting_valid(const Field&, const Material& m) {
   bool ok = true;
-  for_each_field(m, [&](const Field& f, double v) { ok = ok && f.range.contains(v); });
+  for_each_field(m, [&](const Field& f, const auto& v) { ok = ok && setting_valid(f, v); });
   return ok;
 }
 
@@ -454,10 +456,7 @@ void validate(const State& s, const std::string& path) {
   const auto& b = s.bonds;
   pair_like(b, "bonds", bond_columns);
   for (std::size_t k = 0; k < b.n; ++k) need(b.beam_radius[k] >= 0, "bonds/beam_radius");
-  const BondMaterial& bm = b.material;
-  need(bm.beam_kn > 0 && finite(bm.beam_kn) && bm.beam_ks > 0 && finite(bm.beam_ks) && bm.radius_factor > 0 &&
-           finite(bm.radius_factor) && bm.tensile_strength >= 0 && finite(bm.tensile_strength),
-       "bonds/material");
+  need(setting_valid(Field{"material"}, b.material), "bonds/material");
   for (const BreakEvent& e : s.break_events)
     need(e.id_a >= 0 && e.id_b >= 0 && e.id_a < std::int64_t(n) && e.id_b < std::int64_t(n) &&
              std::uint8_t(e.mode) <= 2,

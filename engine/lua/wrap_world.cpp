@@ -81,8 +81,6 @@ std::vector<std::int64_t> ids_arg(lua_State* L, int arg, const World& w, const c
   return ids;
 }
 
-namespace {
-
 // Option f.name of a settings table into v, by type; an absent option keeps v. The World checks
 // the values; an integer is checked here, before it is narrowed.
 void read_option(lua_State*, Options& o, const Field& f, double& v) { v = o.number(f.name, v); }
@@ -100,6 +98,8 @@ void read_option(lua_State*, Options& o, const Field& f, Vec3& v) {
 void read_option(lua_State* L, Options& o, const Field& f, ContactMaterial& v) {
   v = material_field(L, o, f.name, v);
 }
+
+namespace {
 
 void push_value(lua_State* L, double v) { lua_pushnumber(L, v); }
 void push_value(lua_State* L, int v) { lua_pushinteger(L, v); }

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "asperity/world.hpp"
@@ -20,6 +21,13 @@ int group_arg(lua_State* L, int arg, const World& w);
 // material = {kn=, ks=, friction=}; fields not given keep `base`.
 ContactMaterial material_field(lua_State* L, Options& o, const char* key, ContactMaterial base);
 void push_material(lua_State* L, const ContactMaterial& m);
+// Option f.name of a settings table into v, by its type; an absent option keeps v (fields.hpp).
+void read_option(lua_State* L, Options& o, const Field& f, double& v);
+void read_option(lua_State* L, Options& o, const Field& f, int& v);
+void read_option(lua_State* L, Options& o, const Field& f, bool& v);
+void read_option(lua_State* L, Options& o, const Field& f, std::string& v);
+void read_option(lua_State* L, Options& o, const Field& f, Vec3& v);
+void read_option(lua_State* L, Options& o, const Field& f, ContactMaterial& v);
 // Particles named by a list of ids (table or Array) or by a predicate function(id, pos, r).
 std::vector<std::int64_t> ids_arg(lua_State* L, int arg, const World& w, const char* context);
 

@@ -28,23 +28,22 @@ int world_install_bonds(lua_State* L) {
     World& w = world_arg(L);
     const std::string ctx = "world:install_bonds";
     Options o(L, 2, ctx, 2);
-    BondMaterial m;
     // Defaults of the Lua layer: the beam as stiff as the world's contact springs (model.md 5:
-    // kbn A = kn, kbs = kbn / 10), not the C++ struct's constants.
-    m.beam_kn = o.number("beam_kn", w.settings().contact.kn);
-    m.beam_ks = o.number("beam_ks", m.beam_kn / 10);
-    m.radius_factor = o.number("radius_factor", m.radius_factor);
-    m.breakable = o.boolean("breakable", true);
-    auto st = o.number("tensile_strength");
+    // kbn A = kn, kbs = kbn / 10), not the C++ struct's constants; a breakable bond needs its
+    // strength given.
+    const bool ks_given = o.present("beam_ks"), st_given = o.present("tensile_strength");
+    BondMaterial m;
+    m.beam_kn = w.settings().contact.kn;
+    for_each_field(m, [&](const Field& f, auto& v) { read_option(L, o, f, v); });
+    if (!ks_given) m.beam_ks = m.beam_kn / 10;
     double tolerance = o.number("tolerance", -1);
     const bool stress_free = o.boolean("stress_free", false);
     std::vector<std::int64_t> ids;
     if (o.push("ids") != LUA_TNIL) ids = ids_arg(L, lua_gettop(L), w, ctx.c_str());
     lua_pop(L, 1);
     o.finish();
-    if (m.breakable && !st)
+    if (m.breakable && !st_given)
       throw Error(ctx + ": give tensile_strength = (Pa), or breakable = false for elastic bonds");
-    if (st) m.tensile_strength = *st;
     lua_pushinteger(L, static_cast<lua_Integer>(w.install_bonds(m, tolerance, ids, stress_free)));
     return 1;
   });

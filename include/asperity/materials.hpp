@@ -2,13 +2,23 @@
 // World), and all that the engine's bond and wall stores need of it.
 #pragma once
 
+#include <limits>
+#include <type_traits>
+
+#include "asperity/fields.hpp"
+
 namespace asperity {
+
+// The stiffnesses a contact accepts (kn; ks may be 0), N/m: wide enough for any scene, narrow
+// enough that the critical time step and the forces stay finite.
+inline constexpr double kMinStiffness = 1e-12, kMaxStiffness = 1e15;
 
 // Contact springs and friction (model.md 4). Source values: kn = 0.1 N/m, ks = kn/10, mu = 0.5.
 struct ContactMaterial {
   double kn = 0.1;         // normal stiffness, N/m
   double ks = 0.01;        // shear stiffness, N/m
   double friction = 0.5;   // Coulomb coefficient mu
+  bool operator==(const ContactMaterial&) const = default;
 };
 
 // Contact bond + parallel bond installed together (model.md 5). The beam of radius
@@ -20,6 +30,37 @@ struct BondMaterial {
   double radius_factor = 1.0;      // lambda
   double tensile_strength = 0.0;   // st, Pa (elliptic criterion [3-46..3-49])
   bool breakable = true;           // false: the elastic model (bonds never break)
+  bool operator==(const BondMaterial&) const = default;
 };
+
+// visit(field, member) for each field of a contact material.
+template <class Material, class Visit>
+void for_each_field(Material& m, Visit&& visit)
+  requires std::is_same_v<std::remove_const_t<Material>, ContactMaterial>
+{
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  visit(Field{"kn", "kn", 1, {kMinStiffness, kMaxStiffness, false, false, nullptr, "N/m"},
+              "normal stiffness, N/m"},
+        m.kn);
+  visit(Field{"ks", "ks", 1, {0, kMaxStiffness, false, false, nullptr, "N/m"}, "shear stiffness, N/m"},
+        m.ks);
+  visit(Field{"friction", "friction", 1, {0, inf, false, true}, "Coulomb coefficient mu"}, m.friction);
+}
+
+// visit(field, member) for each field of a bond material (checked when bonds are installed, read
+// by the Lua binding, saved by a checkpoint). A breakable bond also needs tensile_strength > 0.
+template <class Material, class Visit>
+  requires std::is_same_v<std::remove_const_t<Material>, BondMaterial>
+void for_each_field(Material& m, Visit&& visit) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  visit(Field{"beam_kn", "beam_kn", 1, {0, inf, true, true, nullptr, "N/m"}, "kbn A, N/m"}, m.beam_kn);
+  visit(Field{"beam_ks", "beam_ks", 1, {0, inf, true, true, nullptr, "N/m"}, "kbs A, N/m"}, m.beam_ks);
+  visit(Field{"radius_factor", "radius_factor", 1, {0, inf, true, true}, "lambda: Rb = lambda min(Ra, Rb) [3-26]"},
+        m.radius_factor);
+  visit(Field{"tensile_strength", "tensile_strength", 1, {0, inf, false, true, nullptr, "Pa"},
+              "st, Pa (elliptic criterion [3-46..3-49])"},
+        m.tensile_strength);
+  visit(Field{"breakable", "breakable", 1, {}, "false: the elastic model (bonds never break)"}, m.breakable);
+}
 
 }  // namespace asperity

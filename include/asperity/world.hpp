@@ -37,7 +37,6 @@ struct State;
 inline constexpr double kMinDensity = 1e-6, kMaxDensity = 1e9;     // kg/m^3
 inline constexpr double kMinRadius = 1e-6, kMaxRadius = 1e3;       // m
 inline constexpr double kMaxCoordinate = 1e9;                      // m, |x|, |y|, |z|
-inline constexpr double kMinStiffness = 1e-12, kMaxStiffness = 1e15;  // N/m (kn; ks may be 0)
 inline constexpr double kMinDt = 1e-15;                            // s, a fixed time step
 inline constexpr double kMinDtSafety = 1e-3;                       // dt / critical estimate
 inline constexpr int kMaxThreads = 1024;                           // OpenMP threads asked for
@@ -119,20 +118,6 @@ void for_each_setting(Settings& s, Visit&& visit) {
               "health: the deepest contact or bond overlap allowed, in radii of its smaller body "
               "(a rigid block's contacts may pass deeper than 1)"},
         s.overlap_limit);
-}
-
-// visit(field, member) for each field of a contact material.
-template <class Material, class Visit>
-void for_each_field(Material& m, Visit&& visit)
-  requires std::is_same_v<std::remove_const_t<Material>, ContactMaterial>
-{
-  constexpr double inf = std::numeric_limits<double>::infinity();
-  visit(Field{"kn", "kn", 1, {kMinStiffness, kMaxStiffness, false, false, nullptr, "N/m"},
-              "normal stiffness, N/m"},
-        m.kn);
-  visit(Field{"ks", "ks", 1, {0, kMaxStiffness, false, false, nullptr, "N/m"}, "shear stiffness, N/m"},
-        m.ks);
-  visit(Field{"friction", "friction", 1, {0, inf, false, true}, "Coulomb coefficient mu"}, m.friction);
 }
 
 // How a rigid group's degree of freedom moves (model.md 1, 7).

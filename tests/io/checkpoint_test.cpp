@@ -205,3 +205,49 @@ TEST(Checkpoint, InconsistentContentsAreRefusedByName) {
   }
   std::filesystem::remove(path);
 }
+
+namespace {
+// A valid value other than v, by the field's range, for every type a settings table holds.
+double other_value(const Field& f, double v) {
+  for (double c : {v * 1.1, v * 0.9, v + 1, f.range.lo + 1, 0.5 * (f.range.lo + f.range.hi)})
+    if (c != v && std::isfinite(c) && f.range.contains(c)) return c;
+  return v;
+}
+int other_value(const Field& f, int v) { return f.range.contains(v + 1) ? v + 1 : v - 1; }
+bool other_value(const Field&, bool v) { return !v; }
+Vec3 other_value(const Field&, const Vec3& v) { return v + Vec3{0.5, -0.25, 0.125}; }
+std::string other_value(const Field&, const std::string& v) { return v; }
+ContactMaterial other_value(const Field&, ContactMaterial m) {
+  for_each_field(m, [](const Field& f, double& v) { v = other_value(f, v); });
+  return m;
+}
+}  // namespace
+
+// Every setting the table marks as stored comes back from a checkpoint with the value it was
+// saved with (each set away from its default, so a field the checkpoint forgot would come back
+// as the default); the loader's own (threads, simd) are not taken from the file.
+TEST(Checkpoint, EveryStoredSettingComesBackFromTheTable) {
+  WorldSettings ws;
+  for_each_setting(ws, [](const Field& f, auto& v) { v = other_value(f, v); });
+  ws.threads = 1;
+  World w(ws);
+  w.add_particle({0, 0, 0}, 1e-3);
+  const std::string path = temp_file("asperity_checkpoint_settings.h5");
+  w.save(path);
+  const World back = World::load(path);
+  const WorldSettings& got = back.settings();
+  const WorldSettings defaults;
+  int stored = 0;
+  for_each_setting(ws, [&](const Field& f, const auto& v) {
+    if (f.stored == nullptr) return;
+    ++stored;
+    // The same member of the loaded settings, by its offset in the struct.
+    const auto offset = reinterpret_cast<const char*>(&v) - reinterpret_cast<const char*>(&ws);
+    const auto& loaded = *reinterpret_cast<const std::decay_t<decltype(v)>*>(reinterpret_cast<const char*>(&got) + offset);
+    const auto& fallback = *reinterpret_cast<const std::decay_t<decltype(v)>*>(reinterpret_cast<const char*>(&defaults) + offset);
+    EXPECT_TRUE(loaded == v) << f.name;
+    EXPECT_FALSE(v == fallback) << f.name << " was not moved away from its default";
+  });
+  EXPECT_GE(stored, 14);
+  std::filesystem::remove(path);
+}

@@ -667,3 +667,36 @@ TEST(Bonds, BondedBlockIsDeterministicAcrossThreadsAndSurvivesReorders) {
     }
   }
 }
+
+// A bond material is checked field by field against its table (materials.hpp) before anything
+// is installed, and the refusal names the field and its range; one material per world.
+TEST(Bonds, ABadBondMaterialIsRefusedByNameAndNothingIsInstalled) {
+  World w;
+  w.add_particle({0, 0, 0}, kR);
+  w.add_particle({0, 0, 2 * kR}, kR);
+  auto error_of = [&](const BondMaterial& m) {
+    try {
+      w.install_bonds(m);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  BondMaterial bad;
+  bad.beam_kn = -1;
+  bad.tensile_strength = 1;
+  EXPECT_EQ(error_of(bad), "bond material: beam_kn -1 outside (0, inf) N/m");
+  bad = BondMaterial{};
+  bad.radius_factor = 0;
+  bad.breakable = false;
+  EXPECT_EQ(error_of(bad), "bond material: radius_factor 0 outside (0, inf)");
+  bad = BondMaterial{};
+  EXPECT_NE(error_of(bad).find("a breakable bond needs tensile_strength > 0"), std::string::npos);
+  EXPECT_EQ(w.bond_count(), 0u);
+  BondMaterial good;
+  good.breakable = false;
+  EXPECT_EQ(w.install_bonds(good), 1u);
+  BondMaterial other = good;
+  other.beam_ks *= 2;
+  EXPECT_NE(error_of(other).find("one bond material per world"), std::string::npos);
+}
