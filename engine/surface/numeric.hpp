@@ -12,21 +12,21 @@
 namespace asperity::surface::detail {
 
 class CompensatedSum {
-public:
-    void add(double x) {
-        const double t = sum_ + x;
-        // Neumaier: recover the low-order bits lost in whichever operand was smaller.
-        if (std::abs(sum_) >= std::abs(x))
-            compensation_ += (sum_ - t) + x;
-        else
-            compensation_ += (x - t) + sum_;
-        sum_ = t;
-    }
-    double value() const { return sum_ + compensation_; }
+ public:
+  void add(double x) {
+    const double t = sum_ + x;
+    // Neumaier: recover the low-order bits lost in whichever operand was smaller.
+    if (std::abs(sum_) >= std::abs(x))
+      compensation_ += (sum_ - t) + x;
+    else
+      compensation_ += (x - t) + sum_;
+    sum_ = t;
+  }
+  double value() const { return sum_ + compensation_; }
 
-private:
-    double sum_ = 0.0;
-    double compensation_ = 0.0;
+ private:
+  double sum_ = 0.0;
+  double compensation_ = 0.0;
 };
 
 inline constexpr double pi = std::numbers::pi;

@@ -36,24 +36,24 @@ namespace asperity::surface {
 // Generation parameters [2-41..2-57]
 
 struct SurfaceParams {
-    int n = 365;              // grid points per side; odd so that only u = v = 0 is self-conjugate
-    double side = 0.10;       // L (m): side length and period of the surface
-    double hurst_x = 0.75;    // Hx: roughness exponent of profiles along x (0 < H <= 1)
-    double hurst_y = 0.75;    // Hy
-    double corr_length_x = 0.016;  // Lcx (m): self-affine correlation length, roll-off chi = 1/(2 Lc)
-    double corr_length_y = 0.016;  // Lcy (m)
-    double variance = 0.547e-6;    // s2 (m^2): the height variance, exact by construction
-    double variance_x = 0.0;  // s2x (m^2): anisotropic spectral weight along x; 0 = equal to variance
-    double variance_y = 0.0;  // s2y (m^2); 0 = equal to variance
-    std::uint64_t seed = 1;   // seed of the phase field
-    std::string name;         // "S1".."S8" for the reference surfaces, free text otherwise
+  int n = 365;            // grid points per side; odd so that only u = v = 0 is self-conjugate
+  double side = 0.10;     // L (m): side length and period of the surface
+  double hurst_x = 0.75;  // Hx: roughness exponent of profiles along x (0 < H <= 1)
+  double hurst_y = 0.75;  // Hy
+  double corr_length_x = 0.016;  // Lcx (m): self-affine correlation length, roll-off chi = 1/(2 Lc)
+  double corr_length_y = 0.016;  // Lcy (m)
+  double variance = 0.547e-6;    // s2 (m^2): the height variance, exact by construction
+  double variance_x = 0.0;  // s2x (m^2): anisotropic spectral weight along x; 0 = equal to variance
+  double variance_y = 0.0;  // s2y (m^2); 0 = equal to variance
+  std::uint64_t seed = 1;   // seed of the phase field
+  std::string name;         // "S1".."S8" for the reference surfaces, free text otherwise
 
-    // Isotropic parameters in SI units.
-    static SurfaceParams isotropic(double hurst, double corr_length, double variance,
-                                   std::uint64_t seed = 1, int n = 365, double side = 0.10);
+  // Isotropic parameters in SI units.
+  static SurfaceParams isotropic(double hurst, double corr_length, double variance,
+                                 std::uint64_t seed = 1, int n = 365, double side = 0.10);
 
-    bool is_isotropic() const;
-    double spacing() const { return side / n; }
+  bool is_isotropic() const;
+  double spacing() const { return side / n; }
 };
 
 // Throws asperity::Error naming the offending field when the parameters cannot be used.
@@ -75,43 +75,43 @@ std::vector<std::string> reference_surface_names();
 // same large-scale shape. The generator is xoshiro256** seeded by splitmix64, written out in
 // engine/surface/random.hpp, so the phases are identical on every platform and library version.
 class PhaseField {
-public:
-    PhaseField(int n, std::uint64_t seed);
+ public:
+  PhaseField(int n, std::uint64_t seed);
 
-    int n() const { return n_; }
-    std::uint64_t seed() const { return seed_; }
-    // Phase of frequency (u, v), both in [-(n-1)/2, (n-1)/2]; phase(0, 0) = 0.
-    double phase(int u, int v) const;
+  int n() const { return n_; }
+  std::uint64_t seed() const { return seed_; }
+  // Phase of frequency (u, v), both in [-(n-1)/2, (n-1)/2]; phase(0, 0) = 0.
+  double phase(int u, int v) const;
 
-private:
-    int n_;
-    std::uint64_t seed_;
-    std::vector<double> phase_;  // centred layout: (v + h) * n + (u + h), h = (n - 1) / 2
+ private:
+  int n_;
+  std::uint64_t seed_;
+  std::vector<double> phase_;  // centred layout: (v + h) * n + (u + h), h = (n - 1) / 2
 };
 
 // ------------------------------------------------------------------------------------------------
 // Height maps and profiles
 
 struct HeightMap {
-    int nx = 0;             // columns (x direction)
-    int ny = 0;             // rows (y direction)
-    double spacing = 0.0;   // grid step (m), the same along x and y
-    std::vector<double> height;  // ny * nx heights (m), height[j * nx + i]
-    std::optional<SurfaceParams> params;  // generation parameters, when generated
+  int nx = 0;                           // columns (x direction)
+  int ny = 0;                           // rows (y direction)
+  double spacing = 0.0;                 // grid step (m), the same along x and y
+  std::vector<double> height;           // ny * nx heights (m), height[j * nx + i]
+  std::optional<SurfaceParams> params;  // generation parameters, when generated
 
-    HeightMap() = default;
-    HeightMap(int nx, int ny, double spacing);  // zero heights
+  HeightMap() = default;
+  HeightMap(int nx, int ny, double spacing);  // zero heights
 
-    double& at(int i, int j) { return height[static_cast<std::size_t>(j) * nx + i]; }
-    double at(int i, int j) const { return height[static_cast<std::size_t>(j) * nx + i]; }
-    double x(int i) const { return i * spacing; }
-    double y(int j) const { return j * spacing; }
-    std::size_t size() const { return height.size(); }
+  double& at(int i, int j) { return height[static_cast<std::size_t>(j) * nx + i]; }
+  double at(int i, int j) const { return height[static_cast<std::size_t>(j) * nx + i]; }
+  double x(int i) const { return i * spacing; }
+  double y(int j) const { return j * spacing; }
+  std::size_t size() const { return height.size(); }
 };
 
 struct Profile {
-    double spacing = 0.0;        // step between samples (m)
-    std::vector<double> height;  // heights (m)
+  double spacing = 0.0;        // step between samples (m)
+  std::vector<double> height;  // heights (m)
 };
 
 // Row j (along x) and column i (along y) of a map: exact grid values.
@@ -139,10 +139,10 @@ HeightMap generate_surface(const SurfaceParams& params);
 // Analysis [2-1..2-17]
 
 struct Plane {  // z = a x + b y + c [2-1], x, y in metres from the grid origin
-    double a = 0.0, b = 0.0, c = 0.0;
+  double a = 0.0, b = 0.0, c = 0.0;
 };
 struct Line {  // z = a s + c along a profile, s = k * spacing
-    double a = 0.0, c = 0.0;
+  double a = 0.0, c = 0.0;
 };
 
 Plane fit_mean_plane(const HeightMap& map);
@@ -151,14 +151,14 @@ Line fit_mean_line(const Profile& profile);
 Profile remove_mean_line(const Profile& profile);
 
 struct AmplitudeStats {
-    double mean = 0.0;
-    double ra = 0.0;        // [2-2] mean |z - mean|
-    double rms = 0.0;       // [2-3] sqrt of variance
-    double variance = 0.0;  // population variance (1/N) about the mean
-    double skewness = 0.0;  // [2-5] m3 / m2^1.5
-    double kurtosis = 0.0;  // [2-5] m4 / m2^2 (3 for a Gaussian; not the excess)
-    double min = 0.0, max = 0.0;
-    std::size_t count = 0;
+  double mean = 0.0;
+  double ra = 0.0;        // [2-2] mean |z - mean|
+  double rms = 0.0;       // [2-3] sqrt of variance
+  double variance = 0.0;  // population variance (1/N) about the mean
+  double skewness = 0.0;  // [2-5] m3 / m2^1.5
+  double kurtosis = 0.0;  // [2-5] m4 / m2^2 (3 for a Gaussian; not the excess)
+  double min = 0.0, max = 0.0;
+  std::size_t count = 0;
 };
 AmplitudeStats amplitude_stats(std::span<const double> heights);
 AmplitudeStats amplitude_stats(const HeightMap& map);
@@ -166,10 +166,10 @@ AmplitudeStats amplitude_stats(const Profile& profile);
 
 // A function of the lag: structure function S [2-9], variogram S/2, autocovariance R [2-6].
 struct LagSeries {
-    double angle = 0.0;          // direction (rad); NaN for radial averages and profiles
-    std::vector<double> lag;     // m
-    std::vector<double> value;   // m^2
-    std::vector<double> pairs;   // number of height pairs behind each value
+  double angle = 0.0;         // direction (rad); NaN for radial averages and profiles
+  std::vector<double> lag;    // m
+  std::vector<double> value;  // m^2
+  std::vector<double> pairs;  // number of height pairs behind each value
 };
 
 // Lag statistics of a map, computed once with FFTs for every lattice lag (dx, dy) and then read
@@ -181,31 +181,31 @@ struct LagSeries {
 //   their pair counts, and report the pair-weighted mean |d| as the lag.
 // Autocovariance is about the map mean. max_lag <= 0 means half the smaller side.
 class LagMap {
-public:
-    explicit LagMap(const HeightMap& map);
+ public:
+  explicit LagMap(const HeightMap& map);
 
-    LagSeries structure_function(double angle, double max_lag = 0.0) const;
-    LagSeries structure_function_radial(double max_lag = 0.0) const;
-    LagSeries autocovariance(double angle, double max_lag = 0.0) const;
-    LagSeries autocovariance_radial(double max_lag = 0.0) const;
-    double variance() const { return variance_; }  // about the mean
+  LagSeries structure_function(double angle, double max_lag = 0.0) const;
+  LagSeries structure_function_radial(double max_lag = 0.0) const;
+  LagSeries autocovariance(double angle, double max_lag = 0.0) const;
+  LagSeries autocovariance_radial(double max_lag = 0.0) const;
+  double variance() const { return variance_; }  // about the mean
 
-    // Exact values at a lattice lag (dx, dy) in grid steps, |dx| < nx, |dy| < ny.
-    double structure_at(int dx, int dy) const;
-    double autocovariance_at(int dx, int dy) const;
-    double pairs_at(int dx, int dy) const;
+  // Exact values at a lattice lag (dx, dy) in grid steps, |dx| < nx, |dy| < ny.
+  double structure_at(int dx, int dy) const;
+  double autocovariance_at(int dx, int dy) const;
+  double pairs_at(int dx, int dy) const;
 
-private:
-    enum class Quantity { structure, autocovariance };
-    LagSeries along(Quantity q, double angle, double max_lag) const;
-    LagSeries radial(Quantity q, double max_lag) const;
-    std::size_t index(int dx, int dy) const;
+ private:
+  enum class Quantity { structure, autocovariance };
+  LagSeries along(Quantity q, double angle, double max_lag) const;
+  LagSeries radial(Quantity q, double max_lag) const;
+  std::size_t index(int dx, int dy) const;
 
-    int nx_ = 0, ny_ = 0;
-    double spacing_ = 0.0;
-    double variance_ = 0.0;
-    std::vector<double> structure_;  // (2 nx - 1) x ny: dx in [-(nx-1), nx-1], dy in [0, ny-1]
-    std::vector<double> covariance_;
+  int nx_ = 0, ny_ = 0;
+  double spacing_ = 0.0;
+  double variance_ = 0.0;
+  std::vector<double> structure_;  // (2 nx - 1) x ny: dx in [-(nx-1), nx-1], dy in [0, ny-1]
+  std::vector<double> covariance_;
 };
 
 // Convenience wrappers (each builds a LagMap; build one yourself for several directions).
@@ -223,9 +223,9 @@ LagSeries variogram(const LagSeries& structure_function);
 // the variance (Parseval): m^4 for maps (per (cycle/m)^2), m^3 for profiles (per cycle/m).
 enum class Window { none, hann };
 struct Spectrum {
-    std::vector<double> frequency;  // cycles per metre (ring or bin centre)
-    std::vector<double> psd;
-    std::vector<double> count;      // Fourier modes behind each value
+  std::vector<double> frequency;  // cycles per metre (ring or bin centre)
+  std::vector<double> psd;
+  std::vector<double> count;  // Fourier modes behind each value
 };
 // Ring average over |f| in unit-width rings of the fundamental frequency 1/(n spacing).
 Spectrum radial_psd(const HeightMap& map, Window window = Window::hann);
@@ -237,12 +237,12 @@ Spectrum profile_psd(const Profile& profile, Window window = Window::hann);
 
 // Least-squares straight line through (log x, log y) for x in [x_min, x_max] and y > 0.
 struct PowerLawFit {
-    double hurst = 0.0;      // the roughness exponent the slope stands for
-    double slope = 0.0;      // d log y / d log x
-    double intercept = 0.0;  // log y at x = 1
-    double r2 = 0.0;         // coefficient of determination of the log-log fit
-    double x_min = 0.0, x_max = 0.0;  // the window actually used
-    int points = 0;          // 0 (and NaN hurst) when fewer than 3 points fell in the window
+  double hurst = 0.0;               // the roughness exponent the slope stands for
+  double slope = 0.0;               // d log y / d log x
+  double intercept = 0.0;           // log y at x = 1
+  double r2 = 0.0;                  // coefficient of determination of the log-log fit
+  double x_min = 0.0, x_max = 0.0;  // the window actually used
+  int points = 0;                   // 0 (and NaN hurst) when fewer than 3 points fell in the window
 };
 PowerLawFit fit_power_law(std::span<const double> x, std::span<const double> y, double x_min,
                           double x_max);
@@ -266,10 +266,10 @@ double rolloff_length(const Spectrum& spectrum, const PowerLawFit& psd_fit);
 //   Z2(tau) = sqrt(<(z(r + tau) - z(r))^2>) / tau
 //   Z3(tau) = sqrt(<(z(r + tau) - 2 z(r) + z(r - tau))^2>) / tau^2
 struct SlopeSeries {
-    double angle = 0.0;  // NaN for profiles
-    std::vector<double> step;  // m
-    std::vector<double> z2;    // dimensionless
-    std::vector<double> z3;    // 1/m
+  double angle = 0.0;        // NaN for profiles
+  std::vector<double> step;  // m
+  std::vector<double> z2;    // dimensionless
+  std::vector<double> z3;    // 1/m
 };
 // Steps k * spacing, k = 1..max_steps, along `angle` (bilinear interpolation off the lattice
 // directions, exact on x, y and the diagonals).
@@ -279,17 +279,17 @@ SlopeSeries slope_statistics(const Profile& profile, int max_steps = 20);
 // Colatitude (apparent dip) distribution [2-17]: theta* = atan((z(r + step) - z(r)) / step)
 // along `angle`, positive slopes (facing the direction) and negative slopes separately.
 struct ColatitudeDistribution {
-    double angle = 0.0;          // NaN for profiles
-    double step = 0.0;           // m
-    std::vector<double> bin_edges;   // rad, bins + 1 edges over [0, pi/2]
-    std::vector<double> positive;    // fraction of all samples with theta* > 0 in each |theta*| bin
-    std::vector<double> negative;    // same for theta* < 0 (by |theta*|)
-    double fraction_positive = 0.0;  // share of samples with theta* > 0
-    double mean_positive = 0.0;      // mean theta* over positive samples (rad)
-    double mean_negative = 0.0;      // mean |theta*| over negative samples (rad)
-    double max_positive = 0.0;
-    double max_negative = 0.0;
-    std::size_t samples = 0;
+  double angle = 0.0;              // NaN for profiles
+  double step = 0.0;               // m
+  std::vector<double> bin_edges;   // rad, bins + 1 edges over [0, pi/2]
+  std::vector<double> positive;    // fraction of all samples with theta* > 0 in each |theta*| bin
+  std::vector<double> negative;    // same for theta* < 0 (by |theta*|)
+  double fraction_positive = 0.0;  // share of samples with theta* > 0
+  double mean_positive = 0.0;      // mean theta* over positive samples (rad)
+  double mean_negative = 0.0;      // mean |theta*| over negative samples (rad)
+  double max_positive = 0.0;
+  double max_negative = 0.0;
+  std::size_t samples = 0;
 };
 ColatitudeDistribution colatitude_distribution(const HeightMap& map, double angle,
                                                double step = 0.0, int bins = 90);
@@ -299,8 +299,8 @@ ColatitudeDistribution colatitude_distribution(const Profile& profile, double st
 // Abbott-Firestone (bearing area) curve: bearing_fraction[k] = share of the values >= height[k],
 // at `levels` heights evenly spaced from the maximum down to the minimum.
 struct AbbottCurve {
-    std::vector<double> height;            // m, decreasing
-    std::vector<double> bearing_fraction;  // increasing from 1/N to 1
+  std::vector<double> height;            // m, decreasing
+  std::vector<double> bearing_fraction;  // increasing from 1/N to 1
 };
 AbbottCurve abbott_curve(std::span<const double> values, int levels = 201);
 AbbottCurve abbott_curve(const HeightMap& map, int levels = 201);
@@ -309,47 +309,47 @@ AbbottCurve abbott_curve(const HeightMap& map, int levels = 201);
 // One-call analysis (what scripts/surface.lua writes to summary.json)
 
 struct AnalysisOptions {
-    bool remove_mean_plane = true;
-    Window window = Window::hann;     // for the PSD
-    double max_lag = 0.0;             // m; <= 0: half the smaller side
-    // Structure-function fit window (m). <= 0: automatic, lags from 1 spacing to a quarter of the
-    // measured correlation length (at least 6 lags), i.e. well below Lc (see analysis.cpp).
-    double structure_fit_min_lag = 0.0;
-    double structure_fit_max_lag = 0.0;
-    // PSD fit window (cycles/m). <= 0: automatic, from 1/(2 correlation length) (about 2.5 times
-    // the roll-off of generated surfaces; at least 4 fundamentals) to 0.7 times Nyquist (0.35/h).
-    double psd_fit_min_frequency = 0.0;
-    double psd_fit_max_frequency = 0.0;
-    int directions = 12;          // polar data: directions evenly spread over [0, pi)
-    // rad, PSD sector per direction; <= 0: max(pi / (2 directions), pi / 8) (sectors overlap
-    // with many directions: fewer modes per sector make H and the roll-off too noisy)
-    double sector_half_width = 0.0;
-    int abbott_levels = 201;
-    int colatitude_bins = 90;
-    int slope_max_steps = 20;
+  bool remove_mean_plane = true;
+  Window window = Window::hann;  // for the PSD
+  double max_lag = 0.0;          // m; <= 0: half the smaller side
+  // Structure-function fit window (m). <= 0: automatic, lags from 1 spacing to a quarter of the
+  // measured correlation length (at least 6 lags), i.e. well below Lc (see analysis.cpp).
+  double structure_fit_min_lag = 0.0;
+  double structure_fit_max_lag = 0.0;
+  // PSD fit window (cycles/m). <= 0: automatic, from 1/(2 correlation length) (about 2.5 times
+  // the roll-off of generated surfaces; at least 4 fundamentals) to 0.7 times Nyquist (0.35/h).
+  double psd_fit_min_frequency = 0.0;
+  double psd_fit_max_frequency = 0.0;
+  int directions = 12;  // polar data: directions evenly spread over [0, pi)
+  // rad, PSD sector per direction; <= 0: max(pi / (2 directions), pi / 8) (sectors overlap
+  // with many directions: fewer modes per sector make H and the roll-off too noisy)
+  double sector_half_width = 0.0;
+  int abbott_levels = 201;
+  int colatitude_bins = 90;
+  int slope_max_steps = 20;
 };
 
 struct DirectionalRoughness {
-    double angle = 0.0;               // rad
-    double hurst_structure = 0.0;     // from S along the direction
-    double hurst_psd = 0.0;           // from the PSD sector around the direction
-    double variance = 0.0;            // mean variance of profiles along it (smaller side long)
-    double correlation_length = 0.0;  // the rule above on S along it, with that variance
-    double rolloff_length = 0.0;      // Lc from the corner of the PSD sector
+  double angle = 0.0;               // rad
+  double hurst_structure = 0.0;     // from S along the direction
+  double hurst_psd = 0.0;           // from the PSD sector around the direction
+  double variance = 0.0;            // mean variance of profiles along it (smaller side long)
+  double correlation_length = 0.0;  // the rule above on S along it, with that variance
+  double rolloff_length = 0.0;      // Lc from the corner of the PSD sector
 };
 
 struct RoughnessSummary {
-    Plane mean_plane;
-    AmplitudeStats amplitude;
-    double correlation_length = 0.0;  // from the radially averaged S (the (1 - 1/e) rule)
-    double rolloff_length = 0.0;      // Lc from the corner of the radially averaged PSD
-    PowerLawFit hurst_structure;      // radially averaged S
-    PowerLawFit hurst_psd;            // radially averaged 2-D PSD
-    LagSeries structure_radial;
-    LagSeries structure_x, structure_y;
-    Spectrum psd_radial;
-    AbbottCurve abbott;
-    std::vector<DirectionalRoughness> polar;
+  Plane mean_plane;
+  AmplitudeStats amplitude;
+  double correlation_length = 0.0;  // from the radially averaged S (the (1 - 1/e) rule)
+  double rolloff_length = 0.0;      // Lc from the corner of the radially averaged PSD
+  PowerLawFit hurst_structure;      // radially averaged S
+  PowerLawFit hurst_psd;            // radially averaged 2-D PSD
+  LagSeries structure_radial;
+  LagSeries structure_x, structure_y;
+  Spectrum psd_radial;
+  AbbottCurve abbott;
+  std::vector<DirectionalRoughness> polar;
 };
 RoughnessSummary analyze(const HeightMap& map, const AnalysisOptions& options = {});
 
@@ -359,14 +359,14 @@ std::vector<DirectionalRoughness> polar_roughness(const HeightMap& map,
                                                   const AnalysisOptions& options = {});
 
 struct ProfileSummary {
-    Line mean_line;
-    AmplitudeStats amplitude;
-    double correlation_length = 0.0;
-    double rolloff_length = 0.0;
-    PowerLawFit hurst_structure;
-    PowerLawFit hurst_psd;
-    LagSeries structure;
-    Spectrum psd;
+  Line mean_line;
+  AmplitudeStats amplitude;
+  double correlation_length = 0.0;
+  double rolloff_length = 0.0;
+  PowerLawFit hurst_structure;
+  PowerLawFit hurst_psd;
+  LagSeries structure;
+  Spectrum psd;
 };
 ProfileSummary analyze(const Profile& profile, const AnalysisOptions& options = {});
 
@@ -381,16 +381,16 @@ enum class HalfSide { lower, upper };
 // The profilometer's grid: node (i, j) is at (x0 + i spacing, y0 + j spacing) in the particles'
 // frame. Usually the synthetic map's grid (same nx, ny, spacing) placed where the mold was.
 struct ProfilometerGrid {
-    int nx = 0, ny = 0;
-    double spacing = 0.0;     // m
-    double x0 = 0.0, y0 = 0.0;  // m
+  int nx = 0, ny = 0;
+  double spacing = 0.0;       // m
+  double x0 = 0.0, y0 = 0.0;  // m
 };
 
 struct ProfilometerResult {
-    HeightMap surface;                   // z_dem per node (m); NaN where no particle covers it
-    std::vector<std::int64_t> particle;  // per node: the particle giving the height, -1 if none
-    std::size_t covered = 0;             // nodes with a height
-    std::size_t particles = 0;           // distinct particles giving at least one node
+  HeightMap surface;                   // z_dem per node (m); NaN where no particle covers it
+  std::vector<std::int64_t> particle;  // per node: the particle giving the height, -1 if none
+  std::size_t covered = 0;             // nodes with a height
+  std::size_t particles = 0;           // distinct particles giving at least one node
 };
 
 // Numerical profilometer: for each node the highest (lower half) or lowest (upper half) point
@@ -409,21 +409,21 @@ ProfilometerResult profilometer(std::span<const double> positions, std::span<con
 // plane is the synthetic one shifted by dv_mp, the dv of steepest F (the mode of d), where most
 // nodes of the DEM surface lie on the synthetic surface.
 struct DemMeanPlaneOptions {
-    int levels = 401;         // points of the returned curves, evenly spaced over [min d, max d]
-    double bandwidth = 0.0;   // m, Gaussian kernel for dF/ddv; <= 0: Silverman's rule (see .cpp)
-    double tolerance = 0.0;   // m, |d - dv_mp| <= tolerance counts as coinciding; <= 0: 1 % of
-                              // the synthetic surface's rms height
+  int levels = 401;        // points of the returned curves, evenly spaced over [min d, max d]
+  double bandwidth = 0.0;  // m, Gaussian kernel for dF/ddv; <= 0: Silverman's rule (see .cpp)
+  double tolerance = 0.0;  // m, |d - dv_mp| <= tolerance counts as coinciding; <= 0: 1 % of
+                           // the synthetic surface's rms height
 };
 struct DemMeanPlane {
-    double shift = 0.0;                // dv_mp (m)
-    double coinciding_fraction = 0.0;  // share of covered nodes with |d - dv_mp| <= tolerance
-    double tolerance = 0.0;            // m, as used
-    double bandwidth = 0.0;            // m, as used
-    double mean_difference = 0.0;      // <d> (m): what a plain mean would give (biased by holes)
-    std::size_t points = 0;            // nodes with a finite z_dem
-    std::vector<double> dv;            // m, increasing
-    std::vector<double> cumulative;    // F(dv): share of nodes with z_syn + dv >= z_dem
-    std::vector<double> density;       // dF/ddv (1/m), kernel-smoothed
+  double shift = 0.0;                // dv_mp (m)
+  double coinciding_fraction = 0.0;  // share of covered nodes with |d - dv_mp| <= tolerance
+  double tolerance = 0.0;            // m, as used
+  double bandwidth = 0.0;            // m, as used
+  double mean_difference = 0.0;      // <d> (m): what a plain mean would give (biased by holes)
+  std::size_t points = 0;            // nodes with a finite z_dem
+  std::vector<double> dv;            // m, increasing
+  std::vector<double> cumulative;    // F(dv): share of nodes with z_syn + dv >= z_dem
+  std::vector<double> density;       // dF/ddv (1/m), kernel-smoothed
 };
 // dem and synthetic on the same grid (nx, ny); NaN heights of dem (uncovered nodes) are skipped.
 DemMeanPlane dem_mean_plane(const HeightMap& dem, const HeightMap& synthetic,
@@ -434,12 +434,12 @@ DemMeanPlane dem_mean_plane(const HeightMap& dem, const HeightMap& synthetic,
 // i.e. it touches the expected surface somewhere; the others are porosity particles, seen by the
 // profilometer through holes of the packing below (lower half) or above (upper half) it.
 struct SurfaceParticles {
-    std::vector<std::int64_t> surface;   // particle numbers (as in ProfilometerResult), sorted
-    std::vector<std::int64_t> porosity;  // sorted
-    double retained_fraction = 0.0;      // surface / (surface + porosity)
-    double node_fraction = 0.0;          // share of covered nodes within the band
-    double band = 0.0;                   // m
-    double shift = 0.0;                  // m
+  std::vector<std::int64_t> surface;   // particle numbers (as in ProfilometerResult), sorted
+  std::vector<std::int64_t> porosity;  // sorted
+  double retained_fraction = 0.0;      // surface / (surface + porosity)
+  double node_fraction = 0.0;          // share of covered nodes within the band
+  double band = 0.0;                   // m
+  double shift = 0.0;                  // m
 };
 SurfaceParticles classify_surface_particles(const HeightMap& dem,
                                             std::span<const std::int64_t> node_particle,
@@ -447,21 +447,21 @@ SurfaceParticles classify_surface_particles(const HeightMap& dem,
 inline SurfaceParticles classify_surface_particles(const ProfilometerResult& profile,
                                                    const HeightMap& synthetic, double shift,
                                                    double band) {
-    return classify_surface_particles(profile.surface, profile.particle, synthetic, shift, band);
+  return classify_surface_particles(profile.surface, profile.particle, synthetic, shift, band);
 }
 
 // Noise study: uncorrelated Gaussian noise of standard deviation level * rms(map) added to the
 // map (one noise field of the seed, scaled per level), then H and s2 re-measured with the fit
 // windows of the clean map, so only the surface changes between levels, not the estimator.
 struct NoiseLevel {
-    double level = 0.0;          // noise rms / height rms
-    double noise_rms = 0.0;      // m
-    double variance = 0.0;       // m^2, of the noisy map about its mean plane
-    double hurst_psd = 0.0;
-    double hurst_structure = 0.0;
-    double psd_fit_r2 = 0.0;     // r^2 of the log-log PSD fit: how well a power law still holds
-    double structure_fit_r2 = 0.0;
-    double correlation_length = 0.0;  // m
+  double level = 0.0;      // noise rms / height rms
+  double noise_rms = 0.0;  // m
+  double variance = 0.0;   // m^2, of the noisy map about its mean plane
+  double hurst_psd = 0.0;
+  double hurst_structure = 0.0;
+  double psd_fit_r2 = 0.0;  // r^2 of the log-log PSD fit: how well a power law still holds
+  double structure_fit_r2 = 0.0;
+  double correlation_length = 0.0;  // m
 };
 std::vector<NoiseLevel> noise_study(const HeightMap& map, std::span<const double> levels,
                                     std::uint64_t seed = 1, const AnalysisOptions& options = {});
@@ -470,11 +470,11 @@ std::vector<NoiseLevel> noise_study(const HeightMap& map, std::span<const double
 // Elevation map plot (engine/surface/plot_map.cpp)
 
 struct MapPlotOptions {
-    std::string title;
-    int width = 900, height = 800;  // pixels
-    double length_scale = 1e3;      // axis values = metres * length_scale (mm by default)
-    double height_scale = 1e3;      // colour values = metres * height_scale
-    std::string length_unit = "mm", height_unit = "mm";
+  std::string title;
+  int width = 900, height = 800;  // pixels
+  double length_scale = 1e3;      // axis values = metres * length_scale (mm by default)
+  double height_scale = 1e3;      // colour values = metres * height_scale
+  std::string length_unit = "mm", height_unit = "mm";
 };
 // Heat map of the heights (gnuplot, `with image`), drawn to a temporary name and renamed.
 // NaN nodes are left blank. Throws Error when gnuplot is missing or fails.
@@ -497,8 +497,8 @@ HeightMap load_hdf5(const std::string& path, double spacing_override = 0.0);
 void save_csv(const HeightMap& map, const std::string& path);
 
 struct GridImportOptions {
-    double spacing = 0.0;       // m; <= 0: read it from the file ("# spacing =" or ESRI cellsize)
-    double height_scale = 1.0;  // multiplies the values (e.g. 1e-6 for a scan in micrometres)
+  double spacing = 0.0;       // m; <= 0: read it from the file ("# spacing =" or ESRI cellsize)
+  double height_scale = 1.0;  // multiplies the values (e.g. 1e-6 for a scan in micrometres)
 };
 // Reads a CSV/whitespace grid as written by save_csv, or an ESRI ASCII grid (header ncols,
 // nrows, xllcorner, yllcorner, cellsize, nodata_value; first data row is the northmost, so the
