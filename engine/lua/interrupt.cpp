@@ -21,9 +21,17 @@ std::atomic<int> pending{0};  // interrupts not yet served
 
 void interrupt_hook(lua_State* L, lua_Debug*) {
   lua_sethook(L, nullptr, 0, 0);
-  run_interrupted = false;
+  // Raise only an interruption not yet served: the signal may be delivered to another thread of
+  // the process (an OpenMP worker), whose lua_sethook can then land after this hook or
+  // take_run_interrupt served the interruption; such a late hook only removes itself.
+  if (!run_interrupted.exchange(false)) return;
   pending = 0;
-  luaL_where(L, 1);
+  // Where the Lua code was: the innermost frame with a line (the hook may fire in a C function,
+  // or in a Lua function whose caller is one, like pcall's).
+  int level = 0;
+  for (lua_Debug ar; lua_getstack(L, level, &ar); ++level)
+    if (lua_getinfo(L, "l", &ar) && ar.currentline > 0) break;
+  luaL_where(L, level);
   lua_pushstring(L, "interrupted");
   lua_concat(L, 2);
   make_interruption(L);
