@@ -124,23 +124,44 @@ std::string default_text(const ContactMaterial& m) {
   return t + "}";
 }
 
+// One line per field of a table (fields.hpp): name = default, the values it accepts, its meaning.
+template <class T>
+std::string field_line(const Field& f, const T& v, const char* indent) {
+  std::string t = std::string("\n") + indent + f.name + " = " + default_text(v);
+  if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>)
+    t += (f.range.zero != nullptr ? std::string(" (0: ") + f.range.zero + ") or in " : std::string(" in ")) +
+         range_text(f.range);
+  return t + ": " + f.doc;
+}
+
 // asperity.world's help: every setting with its default, accepted values and meaning.
 const char* world_settings_help() {
   static const std::string text = [] {
     std::string t = "A new world. Options (default: meaning):";
-    WorldSettings defaults;
-    for_each_setting(defaults, [&](const Field& f, const auto& v) {
-      using T = std::decay_t<decltype(v)>;
-      t += std::string("\n  ") + f.name + " = " + default_text(v);
-      if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>)
-        t += (f.range.zero != nullptr ? std::string(" (0: ") + f.range.zero + ") or in " : std::string(" in ")) +
-             range_text(f.range);
-      t += std::string(": ") + f.doc;
-    });
+    const WorldSettings defaults;
+    for_each_setting(defaults, [&](const Field& f, const auto& v) { t += field_line(f, v, "  "); });
     return t;
   }();
   return text.c_str();
 }
+
+}  // namespace
+
+std::string servo_fields_help() {
+  std::string t;
+  const Servo defaults;
+  for_each_field(defaults, [&](const Field& f, double v) { t += field_line(f, v, "    "); });
+  return t;
+}
+
+std::string bond_material_fields_help() {
+  std::string t;
+  const BondMaterial defaults;
+  for_each_field(defaults, [&](const Field& f, const auto& v) { t += field_line(f, v, "    "); });
+  return t;
+}
+
+namespace {
 
 // ---------------------------------------------------------------------------------------------
 // Creation

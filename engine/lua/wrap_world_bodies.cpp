@@ -320,6 +320,20 @@ int world_group_count(lua_State* L) {
   });
 }
 
+// add_group's help: the motion table, and the servo's fields from their table (world.hpp).
+const char* add_group_help() {
+  static const std::string text =
+      "A rigid group of particles: a list of ids, or function(id, pos, r) returning true for\n"
+      "members. motion = {translation = \"free\"|\"fixed\"|\"velocity\"|\"servo\" (or one per\n"
+      "axis), velocity = v, servo = {...} (for every servo axis, or three of them), rotation =\n"
+      "\"fixed\"|\"free\"|\"velocity\", angular_velocity = w, damping = local damping of the free axes\n"
+      "(default: the world's; 0 for a dead-load platen)}. Default: free translation, no rotation.\n"
+      "Giving velocity alone prescribes it. A servo axis moves at clamp(G (F - F_target),\n"
+      "max_velocity) with F the particles' force on the group along it; its fields (default:\n"
+      "meaning):" + servo_fields_help();
+  return text.c_str();
+}
+
 }  // namespace
 
 std::span<const Function> world_body_methods() {
@@ -340,12 +354,7 @@ std::span<const Function> world_body_methods() {
       {"remove_wall", world_remove_wall, "world:remove_wall(wall)", "Removes it (its number is not reused)."},
       {"wall_count", world_wall_count, "world:wall_count() -> n", "Walls created, removed ones included."},
       {"add_group", world_add_group, "world:add_group(ids or predicate [, motion]) -> group",
-       "A rigid group of particles: a list of ids, or function(id, pos, r) returning true for\n"
-       "members. motion = {translation = \"free\"|\"fixed\"|\"velocity\"|\"servo\" (or one per\n"
-       "axis), velocity = v, servo = {target_force=, stiffness=, gain=, relaxation=,\n"
-       "max_velocity=, integral_time=}, rotation = \"fixed\"|\"free\"|\"velocity\", angular_velocity = w,\n"
-       "damping = local damping of the free axes (default: the world's; 0 for a dead-load platen)}.\n"
-       "Default: free translation, no rotation. Giving velocity alone prescribes it."},
+       add_group_help()},
       {"set_group_motion", world_set_group_motion, "world:set_group_motion(group, motion)",
        "Changes how the group moves (fields not given are kept); see add_group."},
       {"group_motion", world_group_motion, "world:group_motion(group) -> motion", "Its motion table."},

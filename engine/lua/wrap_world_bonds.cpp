@@ -158,6 +158,18 @@ int world_break_count(lua_State* L) {
   });
 }
 
+// install_bonds' help, with the bond material's fields from their table (materials.hpp).
+const char* install_bonds_help() {
+  static const std::string text =
+      "Bonds (contact + parallel bond, model.md 5) between every pair closer than tolerance\n"
+      "(default 1e-3 mean radius); beam_kn defaults to the world's kn, beam_ks to beam_kn/10;\n"
+      "ids (a list or predicate) restricts them to pairs of those particles. Existing contact\n"
+      "forces are kept; stress_free = true unloads each contact bond at its current overlap\n"
+      "instead (a contact left by a break keeps that rest overlap until the pair separates).\n"
+      "The material's fields (the C++ struct's default, beam_kn and beam_ks as said above: meaning):" + bond_material_fields_help();
+  return text.c_str();
+}
+
 }  // namespace
 
 int load_world(lua_State* L) {
@@ -192,11 +204,7 @@ std::span<const Function> world_bond_methods() {
       {"install_bonds", world_install_bonds,
        "world:install_bonds{tensile_strength= | breakable=false [, beam_kn=] [, beam_ks=]\n"
        "  [, radius_factor=] [, tolerance=] [, ids=] [, stress_free=false]} -> count",
-       "Bonds (contact + parallel bond, model.md 5) between every pair closer than tolerance\n"
-       "(default 1e-3 mean radius); beam_kn defaults to the world's kn, beam_ks to beam_kn/10;\n"
-       "ids (a list or predicate) restricts them to pairs of those particles. Existing contact\n"
-       "forces are kept; stress_free = true unloads each contact bond at its current overlap\n"
-       "instead (a contact left by a break keeps that rest overlap until the pair separates)."},
+       install_bonds_help()},
       {"bond_count", world_bond_count, "world:bond_count() -> n", "Intact bonds."},
       {"set_bond_strength", world_set_bond_strength,
        "world:set_bond_strength{tensile_strength= | breakable=false}",

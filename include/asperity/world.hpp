@@ -147,15 +147,21 @@ template <class S, class Visit>
   requires std::is_same_v<std::remove_const_t<S>, Servo>
 void for_each_field(S& s, Visit&& visit) {
   constexpr double inf = std::numeric_limits<double>::infinity();
-  visit(Field{"target_force", "target_force", 1, {-inf, inf, true, true, nullptr, "N"}, "N"}, s.target_force);
-  visit(Field{"stiffness", "stiffness", 1, {0, inf, false, true, nullptr, "N/m"}, "N/m; 0: constant normal load"},
+  visit(Field{"target_force", "target_force", 1, {-inf, inf, true, true, nullptr, "N"},
+              "the particles' force on the group along the axis (a top platen pressing down: > 0)"},
+        s.target_force);
+  visit(Field{"stiffness", "stiffness", 1, {0, inf, false, true, nullptr, "N/m"},
+              "constant normal stiffness: the target grows by stiffness x displacement; 0: constant load"},
         s.stiffness);
-  visit(Field{"gain", "gain", 1, {0, inf, false, true}, "m/s per N; 0: automatic"}, s.gain);
-  visit(Field{"relaxation", "relaxation", 1, {0, 1, true, false}, "error corrected per step (automatic gain)"},
+  visit(Field{"gain", "gain", 1, {0, inf, false, true}, "G, m/s per N; 0: automatic, relaxation / (K dt)"},
+        s.gain);
+  visit(Field{"relaxation", "relaxation", 1, {0, 1, true, false},
+              "fraction of the force error corrected per step (automatic gain)"},
         s.relaxation);
-  visit(Field{"max_velocity", "max_velocity", 1, {0, inf, true, true, nullptr, "m/s"}, "m/s"}, s.max_velocity);
+  visit(Field{"max_velocity", "max_velocity", 1, {0, inf, true, true, nullptr, "m/s"}, "bound on the axis's speed"},
+        s.max_velocity);
   visit(Field{"integral_time", "integral_time", 2, {0, inf, false, true, nullptr, "s"},
-              "s; 0: proportional only"},
+              "> 0 adds integral action (no lag while the specimen dilates); 0: proportional only"},
         s.integral_time);
 }
 
