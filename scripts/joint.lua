@@ -53,6 +53,13 @@ local P = params_lib.parse{
   {"shear", 5, unit = "mm", above = 0, doc = "shear displacement"},
   {"residual_window", 0.5, unit = "mm", above = 0, doc = "the residual stress is the mean over the last this much of the shear"},
   {"velocity", 1.5e-5, unit = "m/s", above = 0, doc = "shear velocity (perf/runtime_vs_error.lua: within 1 % of a 2x slower run)"},
+  {"speedup", 1, type = "integer", oneof = {1, 2, 4, 8, 16},
+   doc = "after the peak the shear velocity may double at each record, up to this many times "
+      .. "`velocity`, while the specimen stays quasi-static (speedup_kinetic); 1: constant velocity"},
+  {"speedup_drop", 0.25, above = 0, max = 1,
+   doc = "past the peak: the shear stress below (1 - this) x the highest so far (above it again, the velocity steps back)"},
+  {"speedup_kinetic", 0.002, above = 0,
+   doc = "quasi-static while the kinetic energy stays below this x normal load x mean radius; above it the velocity steps back"},
   {"ramp", 0.05, unit = "mm", min = 0,
    doc = "the shear velocity, and the upper half's approach, rise linearly from 0 over this displacement"},
   {"quasi_static_limit", 0.01, above = 0, doc = "warn when the kinetic energy exceeds this x normal load x mean radius"},

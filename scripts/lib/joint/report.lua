@@ -211,6 +211,8 @@ function M.write(run)
     kinetic_ratio_max = dynamic_ratio,         -- max Ek / (normal load x mean radius) while shearing
     kinetic_ratio_max_at_mm = dynamic_at,
     quasi_static = dynamic_ratio <= P.quasi_static_limit,
+    speedup_max = run.speedup_max,             -- the highest velocity factor the shear reached (speedup)
+    speedup_from_mm = run.speedup_from,        -- where it first rose above 1 (nil: never)
     overlap_ratio_max = overlap_max,           -- deepest overlap / smaller radius, over every record
     overlap_ratio_max_at = run.overlap_at,
     overlaps_small = overlap_max <= P.overlap_limit,

@@ -141,11 +141,21 @@ function M.run(run)
   end
   record_shear()
   local record_every = math.max(1, math.floor(P.record * 1e-3 / (P.velocity * world:dt()) + 0.5))
+  -- Past the peak, the loading rate adapts to the state: the velocity doubles at each record, up to
+  -- `speedup` times, while the kinetic energy stays below speedup_kinetic (the quasi-static
+  -- check's scale), and halves whenever it does not. The records stay `record` mm apart: the
+  -- checks run `speedup` times as often (record_every a multiple of it), and a record is due once
+  -- the steps since the last one, times the velocity factor, reach record_every. speedup = 1 is the
+  -- constant velocity, step for step.
+  record_every = math.ceil(record_every / P.speedup) * P.speedup
+  local tick = record_every // P.speedup
+  local factor, since_record = 1, 0
+  run.speedup_max, run.speedup_from = 1, nil
   -- Event statistics (scenarios.md 8): the energies every `events_every` steps while shearing; the
   -- breaks themselves come from world:break_events. The run then calls back every step, so the records
   -- and the velocity ramp keep their steps (reading the energies still moves a chaotic run in its last
   -- digits: scripts/README.md).
-  local events, sample_every, breaks_before = nil, record_every, world:break_count()
+  local events, sample_every, breaks_before = nil, tick, world:break_count()
   if P.events_every > 0 then
     sample_every = 1
     events = asperity.series{"step [1]", "displacement [mm]", "broken_bonds [1]", "kinetic [J]", "strain [J]",
@@ -160,10 +170,32 @@ function M.run(run)
   local shear_t0, shear_s0, shear_r0 = asperity.wall_time(), world:step(), world:stats().rebuilds
   -- The shear velocity rises linearly over `ramp` mm (time 2 ramp / v), in one stage per record.
   local ramp_stages = P.ramp > 0 and math.max(1, math.ceil(2 * P.ramp * 1e-3 / P.velocity / world:dt() / record_every)) or 1
+  local servo_control = modes[3] == "servo"
   local function set_shear_velocity(stage)
     local v = {0, 0, 0}
-    v[axis] = -P.velocity * math.min(1, stage / ramp_stages)
+    v[axis] = -factor * P.velocity * math.min(1, stage / ramp_stages)
     world:set_group_motion(top, {translation = modes, velocity = v})
+  end
+  -- The velocity factor after a record (the ramp done): up while past the peak and quasi-static,
+  -- back when either ends. The servo's speed limit follows, as the dilatancy rate does.
+  local function adapt_velocity(stage)
+    if P.speedup == 1 or stage < ramp_stages then return end
+    local tau = run:mpa(run:platen_force()[axis] / area)
+    local kinetic = world:energies().kinetic / energy_scale
+    local f = factor
+    if kinetic >= P.speedup_kinetic or tau >= (1 - P.speedup_drop) * peak_seen then f = math.max(1, factor // 2)
+    else f = math.min(P.speedup, 2 * factor) end
+    if f == factor then return end
+    factor = f
+    if factor > run.speedup_max then run.speedup_max = factor end
+    run.speedup_from = run.speedup_from or run:displacement()
+    if servo_control then
+      world:set_group_motion(top, {servo = {target_force = run.target_stress * area, stiffness = cns_stiffness,
+                                            max_velocity = P.servo_max_velocity * factor * P.velocity,
+                                            relaxation = P.servo_relaxation,
+                                            integral_time = P.servo_integral_steps * world:dt()}})
+    end
+    set_shear_velocity(stage)
   end
   if cns_stiffness > 0 then world:set_group_motion(top, {servo = {stiffness = cns_stiffness}}) end
   set_shear_velocity(1)
@@ -174,16 +206,19 @@ function M.run(run)
               if events then
                 local k = world:step() - shear_s0
                 if k % P.events_every == 0 then record_events() end
-                if k % record_every ~= 0 then return end
               end
+              since_record = since_record + sample_every
+              if since_record * factor < record_every then return end
+              since_record = 0
               record_shear()
               if run.escape_every > 0 then run:remove_escaped() end
               if stage < ramp_stages then stage = stage + 1; set_shear_velocity(stage) end
+              adapt_velocity(stage)
             end,
             -- stop less than one record before the end; the last stretch is stepped singly below, so
             -- every run ends at `shear` exactly and the residual's window is always the same
             stop_when = function(w)
-              return run:displacement() >= P.shear - 1e3 * P.velocity * w:dt() * (record_every + 1)
+              return run:displacement() >= P.shear - 1e3 * factor * P.velocity * w:dt() * (record_every + 1)
             end,
             fraction = function() return run:displacement() / P.shear end,
             show = function()
