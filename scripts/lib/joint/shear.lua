@@ -215,10 +215,10 @@ function M.run(run)
               if stage < ramp_stages then stage = stage + 1; set_shear_velocity(stage) end
               adapt_velocity(stage)
             end,
-            -- stop less than one record before the end; the last stretch is stepped singly below, so
+            -- stop less than one check before the end; the last stretch is stepped singly below, so
             -- every run ends at `shear` exactly and the residual's window is always the same
             stop_when = function(w)
-              return run:displacement() >= P.shear - 1e3 * factor * P.velocity * w:dt() * (record_every + 1)
+              return run:displacement() >= P.shear - 1e3 * factor * P.velocity * w:dt() * (tick + 1)
             end,
             fraction = function() return run:displacement() / P.shear end,
             show = function()
