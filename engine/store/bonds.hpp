@@ -49,15 +49,7 @@ struct BondStore {
   template <class F, class... Stores>
   static void columns(F&& f, Stores&... q) {
     f(ColumnInfo{"beam_radius", 0}, q.beam_radius...);  // 0 in padding: never acts or breaks
-    f(ColumnInfo{"nx", 1, true}, q.nx...);
-    f(ColumnInfo{"ny", 0, true}, q.ny...);
-    f(ColumnInfo{"nz", 0, true}, q.nz...);
-    f(ColumnInfo{"fsx", 0, true}, q.fsx...);
-    f(ColumnInfo{"fsy", 0, true}, q.fsy...);
-    f(ColumnInfo{"fsz", 0, true}, q.fsz...);
-    f(ColumnInfo{"fn", 0}, q.fn...);
-    f(ColumnInfo{"overlap", 0}, q.overlap...);
-    f(ColumnInfo{"rest", 0, false, 3}, q.rest...);
+    contact_columns(f, 0, q...);  // the contact bond
     f(ColumnInfo{"fbn", 0}, q.fbn...);
     f(ColumnInfo{"fbsx", 0, true}, q.fbsx...);
     f(ColumnInfo{"fbsy", 0, true}, q.fbsy...);

@@ -16,6 +16,22 @@ struct ColumnInfo {
   bool optional = false;  // allocated on first use (ParticleStore::has_applied)
 };
 
+// The columns of a contact's history, shared by the pair store and the contact bond of the bond
+// store: normal and shear force (vectors on b: they flip), normal force, overlap (padding and
+// fresh entries: `overlap_pad`) and rest overlap (since checkpoint version 3).
+template <class F, class... Stores>
+void contact_columns(F&& f, double overlap_pad, Stores&... q) {
+  f(ColumnInfo{"nx", 1, true}, q.nx...);  // a unit normal along x in padding
+  f(ColumnInfo{"ny", 0, true}, q.ny...);
+  f(ColumnInfo{"nz", 0, true}, q.nz...);
+  f(ColumnInfo{"fsx", 0, true}, q.fsx...);
+  f(ColumnInfo{"fsy", 0, true}, q.fsy...);
+  f(ColumnInfo{"fsz", 0, true}, q.fsz...);
+  f(ColumnInfo{"fn", 0}, q.fn...);
+  f(ColumnInfo{"overlap", overlap_pad}, q.overlap...);
+  f(ColumnInfo{"rest", 0, false, 3}, q.rest...);
+}
+
 // Slots [from, to) of a column set to its padding value.
 template <class V>
 void pad_column(V& col, std::size_t from, std::size_t to, double pad) {

@@ -79,15 +79,7 @@ struct PairStore {
   // carries over, a reorder flips and a checkpoint saves (besides a and b).
   template <class F, class... Stores>
   static void history_columns(F&& f, Stores&... q) {
-    f(ColumnInfo{"nx", 1, true}, q.nx...);  // unit normal along x in padding
-    f(ColumnInfo{"ny", 0, true}, q.ny...);
-    f(ColumnInfo{"nz", 0, true}, q.nz...);
-    f(ColumnInfo{"fsx", 0, true}, q.fsx...);
-    f(ColumnInfo{"fsy", 0, true}, q.fsy...);
-    f(ColumnInfo{"fsz", 0, true}, q.fsz...);
-    f(ColumnInfo{"fn", 0}, q.fn...);
-    f(ColumnInfo{"overlap", -1}, q.overlap...);  // padding pairs never touch
-    f(ColumnInfo{"rest", 0, false, 3}, q.rest...);
+    contact_columns(f, -1, q...);  // padding pairs never touch
   }
 
   void resize(std::size_t count) {
