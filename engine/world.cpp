@@ -683,57 +683,9 @@ std::size_t World::install_bonds(const BondMaterial& material, double tolerance,
     tolerance = 1e-3 * mean / double(p.n);
   }
   for (auto id : ids) index_of(s, id);  // every id valid before anything changes
-  // Candidates come from the neighbour list; make sure it is current and reaches the tolerance.
-  // (The skin is derived first: a world never built has none yet, and 2 x tolerance alone, about
-  // 1e-3 R, would leave it rebuilding the list at every step.)
-  detail::ensure_skin(s);
-  if (s.skin < 2 * tolerance) s.skin = 2 * tolerance;
-  detail::build_neighbors(s);
-  // The chosen particles by index after the build: it may have reordered the store (marked
-  // before it, other particles were bonded: across the mould of the 4 cm joint).
-  std::vector<std::uint8_t> chosen(p.n, ids.empty() ? 1 : 0);
-  for (auto id : ids) chosen[index_of(s, id)] = 1;
-  const auto& q = s.pairs;
-  std::vector<std::size_t> picked;
-  for (std::size_t k = 0; k < q.n; ++k) {
-    const auto a = q.a[k], b = q.b[k];
-    if (!chosen[a] || !chosen[b]) continue;
-    const double dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];
-    const double gap = std::sqrt(dx * dx + dy * dy + dz * dz) - p.radius[a] - p.radius[b];
-    if (gap <= tolerance) picked.push_back(k);
-  }
-  // The new bonds, in the pair list's (a, b) order, merged into the sorted bond list.
-  detail::BondStore fresh;
-  fresh.resize(picked.size());
-  for (std::size_t k = 0; k < picked.size(); ++k) {
-    const std::size_t c = picked[k];
-    const auto a = q.a[c], b = q.b[c];
-    const double dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];
-    const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
-    fresh.a[k] = a;
-    fresh.b[k] = b;
-    fresh.beam_radius[k] = material.radius_factor * std::min(p.radius[a], p.radius[b]);  // [3-26]
-    fresh.nx[k] = dx / d; fresh.ny[k] = dy / d; fresh.nz[k] = dz / d;
-    // An existing contact's forces are kept by the contact bond (model.md 5); stress-free, the
-    // contact bond is unloaded at the current overlap instead. The beam starts unloaded.
-    fresh.fsx[k] = stress_free ? 0.0 : q.fsx[c];
-    fresh.fsy[k] = stress_free ? 0.0 : q.fsy[c];
-    fresh.fsz[k] = stress_free ? 0.0 : q.fsz[c];
-    fresh.overlap[k] = p.radius[a] + p.radius[b] - d;
-    fresh.rest[k] = stress_free ? fresh.overlap[k] : 0.0;
-    fresh.fn[k] = s.settings.contact.kn * (fresh.overlap[k] - fresh.rest[k]);
-    fresh.fbn[k] = fresh.fbsx[k] = fresh.fbsy[k] = fresh.fbsz[k] = 0;
-    fresh.mbn[k] = fresh.mbsx[k] = fresh.mbsy[k] = fresh.mbsz[k] = fresh.broken[k] = 0;
-  }
-  s.bonds = detail::merge_bonds(s.bonds, fresh);
-  s.bonds.material = material;
-  s.bonds.any = true;
-  s.frozen_bonds.material = material;
-  s.frozen_bonds.any = true;
-  if (stress_free && !picked.empty()) s.rest_overlaps = true;
-  detail::refresh_bond_topology(s);
+  const std::size_t installed = detail::install_bonds(s, material, tolerance, ids, stress_free);
   changed(s, Change::particles);  // bonded pairs leave the contact list
-  return picked.size();
+  return installed;
 }
 
 std::size_t World::bond_count() const { return state_->bonds.n + state_->frozen_bonds.n; }
@@ -749,12 +701,8 @@ void World::set_bond_strength(double tensile_strength, bool breakable) {
 }
 
 void World::remove_bonds() {
-  State& s = *state_;
-  s.bonds.resize(0);
-  s.frozen_bonds.resize(0);
-  s.p.bonds_broken.assign(s.p.n, 0);  // no bond left, none counts as broken
-  detail::refresh_bond_topology(s);
-  changed(s, Change::particles);  // the freed pairs enter the contact list at the next rebuild
+  detail::remove_bonds(*state_);
+  changed(*state_, Change::particles);  // the freed pairs enter the contact list at the next rebuild
 }
 
 double World::bond_criterion(double sigma, double tau, double tensile_strength) {

@@ -294,4 +294,68 @@ void process_breaks(State& s) {
   insert_pairs(s, freed);
 }
 
+// --- the bond list's life cycle: installed, broken (process_breaks), frozen, removed ---------
+
+std::size_t install_bonds(State& s, const BondMaterial& material, double tolerance,
+                          std::span<const std::int64_t> ids, bool stress_free) {
+  auto& p = s.p;
+  // Candidates come from the neighbour list; make sure it is current and reaches the tolerance.
+  // (The skin is derived first: a world never built has none yet, and 2 x tolerance alone, about
+  // 1e-3 R, would leave it rebuilding the list at every step.)
+  ensure_skin(s);
+  if (s.skin < 2 * tolerance) s.skin = 2 * tolerance;
+  build_neighbors(s);
+  // The chosen particles by index after the build: it may have reordered the store (marked
+  // before it, other particles were bonded: across the mould of the 4 cm joint).
+  std::vector<std::uint8_t> chosen(p.n, ids.empty() ? 1 : 0);
+  for (auto id : ids) chosen[std::size_t(s.p.index_of_id[std::size_t(id)])] = 1;
+  const auto& q = s.pairs;
+  std::vector<std::size_t> picked;
+  for (std::size_t k = 0; k < q.n; ++k) {
+    const auto a = q.a[k], b = q.b[k];
+    if (!chosen[a] || !chosen[b]) continue;
+    const double dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];
+    const double gap = std::sqrt(dx * dx + dy * dy + dz * dz) - p.radius[a] - p.radius[b];
+    if (gap <= tolerance) picked.push_back(k);
+  }
+  // The new bonds, in the pair list's (a, b) order, merged into the sorted bond list.
+  BondStore fresh;
+  fresh.resize(picked.size());
+  for (std::size_t k = 0; k < picked.size(); ++k) {
+    const std::size_t c = picked[k];
+    const auto a = q.a[c], b = q.b[c];
+    const double dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];
+    const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
+    fresh.a[k] = a;
+    fresh.b[k] = b;
+    fresh.beam_radius[k] = material.radius_factor * std::min(p.radius[a], p.radius[b]);  // [3-26]
+    fresh.nx[k] = dx / d; fresh.ny[k] = dy / d; fresh.nz[k] = dz / d;
+    // An existing contact's forces are kept by the contact bond (model.md 5); stress-free, the
+    // contact bond is unloaded at the current overlap instead. The beam starts unloaded.
+    fresh.fsx[k] = stress_free ? 0.0 : q.fsx[c];
+    fresh.fsy[k] = stress_free ? 0.0 : q.fsy[c];
+    fresh.fsz[k] = stress_free ? 0.0 : q.fsz[c];
+    fresh.overlap[k] = p.radius[a] + p.radius[b] - d;
+    fresh.rest[k] = stress_free ? fresh.overlap[k] : 0.0;
+    fresh.fn[k] = s.settings.contact.kn * (fresh.overlap[k] - fresh.rest[k]);
+    fresh.fbn[k] = fresh.fbsx[k] = fresh.fbsy[k] = fresh.fbsz[k] = 0;
+    fresh.mbn[k] = fresh.mbsx[k] = fresh.mbsy[k] = fresh.mbsz[k] = fresh.broken[k] = 0;
+  }
+  s.bonds = merge_bonds(s.bonds, fresh);
+  s.bonds.material = material;
+  s.bonds.any = true;
+  s.frozen_bonds.material = material;
+  s.frozen_bonds.any = true;
+  if (stress_free && !picked.empty()) s.rest_overlaps = true;
+  refresh_bond_topology(s);
+  return picked.size();
+}
+
+void remove_bonds(State& s) {
+  s.bonds.resize(0);
+  s.frozen_bonds.resize(0);
+  s.p.bonds_broken.assign(s.p.n, 0);  // no bond left, none counts as broken
+  refresh_bond_topology(s);
+}
+
 }  // namespace asperity::detail

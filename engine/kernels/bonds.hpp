@@ -1,11 +1,19 @@
-// Stage 3 of a step: bond forces and breaks, and the bond list's life between steps
-// (kernels/bonds.cpp).
+// Stage 3 of a step: bond forces and breaks; and the bond list's whole life (installed, broken,
+// frozen inside rigid bodies, removed), in one place (kernels/bonds.cpp).
 #pragma once
+#include <cstdint>
+#include <span>
+
 #include "state.hpp"
 
 namespace asperity::detail {
 
 StageLoop bond_stage(State& s);
+// Bonds between the chosen particles (all when `ids` is empty) at most `tolerance` apart, merged
+// into the bond list (material, tolerance and ids checked by the caller); returns how many.
+std::size_t install_bonds(State& s, const BondMaterial& material, double tolerance,
+                          std::span<const std::int64_t> ids, bool stress_free);
+void remove_bonds(State& s);  // every bond, no events, no energy booked
 kernels::BondKernelArgs bond_kernel_args(State& s);  // its kernel's arguments (perf/ reuses them)
 void process_breaks(State& s);         // events, energy, compaction
 void refresh_bond_topology(State& s);  // incidence, partners, rotation locks
