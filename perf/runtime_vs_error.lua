@@ -58,7 +58,6 @@ local scenes = {
       {"velocity_x4", "velocity x 4", {velocity = 4 * v}},
       {"speedup_2", "after the peak up to 2 x velocity (joint.lua speedup)", {speedup = 2}},
       {"speedup_4", "after the peak up to 4 x velocity", {speedup = 4}},
-      {"speedup_8", "after the peak up to 8 x velocity", {speedup = 8}},
       {"dt_0.5", "dt 0.5 x estimate", {dt_safety = 0.5}},
       {"dt_0.8", "dt 0.8 x estimate (the engine's default)", {dt_safety = 0.8}},
       {"skin_0.5", "skin 2.5e-5 m (0.05 mean radius; the default is 0.1)", {skin = 2.5e-5}},

@@ -53,7 +53,7 @@ local P = params_lib.parse{
   {"shear", 5, unit = "mm", above = 0, doc = "shear displacement"},
   {"residual_window", 0.5, unit = "mm", above = 0, doc = "the residual stress is the mean over the last this much of the shear"},
   {"velocity", 1.5e-5, unit = "m/s", above = 0, doc = "shear velocity (perf/runtime_vs_error.lua: within 1 % of a 2x slower run)"},
-  {"speedup", 1, type = "integer", oneof = {1, 2, 4, 8, 16},
+  {"speedup", 1, type = "integer", oneof = {1, 2, 4},
    doc = "after the peak the shear velocity may double at each record, up to this many times "
       .. "`velocity`, while the specimen stays quasi-static (speedup_kinetic); 1: constant velocity"},
   {"speedup_drop", 0.25, above = 0, max = 1,

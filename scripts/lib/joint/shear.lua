@@ -178,10 +178,15 @@ function M.run(run)
   end
   -- The velocity factor after a record (the ramp done): up while past the peak and quasi-static,
   -- back when either ends. The servo's speed limit follows, as the dilatancy rate does.
+  local upper_mass = 0  -- the upper half, carried at the shear velocity
+  if P.speedup > 1 then for _, id in ipairs(run.upper) do upper_mass = upper_mass + world:mass(id) end end
   local function adapt_velocity(stage)
     if P.speedup == 1 or stage < ramp_stages then return end
     local tau = run:mpa(run:platen_force()[axis] / area)
-    local kinetic = world:energies().kinetic / energy_scale
+    -- The specimen's own motion: its kinetic energy less the upper half's translation at the
+    -- shear velocity, which grows with the square of the factor and says nothing of dynamics.
+    local bulk = 0.5 * upper_mass * (factor * P.velocity) ^ 2
+    local kinetic = math.max(0, world:energies().kinetic - bulk) / energy_scale
     local f = factor
     if kinetic >= P.speedup_kinetic or tau >= (1 - P.speedup_drop) * peak_seen then f = math.max(1, factor // 2)
     else f = math.min(P.speedup, 2 * factor) end
