@@ -118,6 +118,10 @@ local P = params_lib.parse{
     end
     if P.record >= P.shear then fail("record", ("must be < shear (%g mm)"):format(P.shear)) end
     if P.ramp >= P.shear then fail("ramp", ("must be < shear (%g mm)"):format(P.shear)) end
+    if P.speedup > 1 and P.model == "fracture" then
+      fail("speedup", "is not for the fracture model: its results depend on the loading rate already at "
+                      .. "`velocity` (perf/README.md, loading rate after the peak); give speedup=1")
+    end
     if given.snapshots ~= nil then
       for _, s in ipairs(params_lib.split(P.snapshots, true)) do
         if s > P.shear then fail("snapshots", ("%g mm is beyond shear = %g mm"):format(s, P.shear)) end
