@@ -79,6 +79,14 @@ void check_value(const std::string&, const Field&, const std::string&) {}  // si
 void check_value(const std::string& where, const Field& f, const Vec3& v) {
   require_finite(v, (where + f.name).c_str());
 }
+void check_value(const std::string& where, const Field& f, Dof d) {
+  require(d == Dof::free || d == Dof::fixed || d == Dof::velocity || d == Dof::servo,
+          where + "unknown " + f.name + " mode");
+}
+void check_value(const std::string& where, const Field& f, const std::array<Dof, 3>& modes) {
+  for (Dof d : modes) check_value(where, f, d);
+}
+void check_value(const std::string&, const Field&, const std::array<Servo, 3>&) {}  // per servo axis, below
 void check_material(const ContactMaterial& m, const std::string& where) {
   for_each_field(m, [&](const Field& f, double v) { check_value(where + ": ", f, v); });
 }
@@ -485,11 +493,7 @@ namespace {
 // Every check of set_group_motion, so that add_group can make them before it changes anything.
 void check_motion(const State& s, const GroupMotion& motion, bool has_inert, const std::string& who) {
   const std::string at = who + ": ";
-  require_finite(motion.velocity, (at + "group velocity").c_str());
-  require_finite(motion.angular_velocity, (at + "group angular velocity").c_str());
-  auto valid = [](Dof d) { return d == Dof::free || d == Dof::fixed || d == Dof::velocity || d == Dof::servo; };
-  for (int k = 0; k < 3; ++k) require(valid(motion.translation[k]), at + "unknown translation mode");
-  require(valid(motion.rotation), at + "unknown rotation mode");
+  for_each_field(motion, [&](const Field& f, const auto& v) { check_value(at, f, v); });
   require(s.settings.rotation || motion.rotation == Dof::fixed,
           at + "group rotation needs a world with rotation enabled");
   require(motion.rotation != Dof::servo, at + "rotation cannot be servo-controlled (translation only)");
@@ -502,9 +506,6 @@ void check_motion(const State& s, const GroupMotion& motion, bool has_inert, con
     const std::string where = at + "servo on " + axis[k] + ": ";
     for_each_field(sv, [&](const Field& f, double v) { check_value(where, f, v); });
   }
-  require(std::isfinite(motion.damping) && motion.damping < 1,
-          at + "group damping must be below 1 (a negative value: the world's local damping), got " +
-              num(motion.damping));
 }
 }  // namespace
 

@@ -151,11 +151,20 @@ void visit_value(auto& io, const std::string& at, int& v) { io.scalar(at, v); }
 void visit_value(auto& io, const std::string& at, bool& v) { io.flag(at, v); }
 void visit_value(auto& io, const std::string& at, Vec3& v) { io.vec(at, v); }
 void visit_value(auto&, const std::string&, std::string&) {}  // no text setting is saved
-void visit_value(auto& io, const std::string& at, ContactMaterial& m) {
-  for_each_field(m, [&](const Field& f, auto& v) { visit_value(io, at + "/" + f.stored, v); });
+void visit_value(auto&, const std::string&, Dof&) {}  // the modes: one column per group (visit)
+void visit_value(auto&, const std::string&, std::array<Dof, 3>&) {}
+// A struct with a field table: its stored fields under `at`, those newer than the file kept.
+template <class Io, class Table>
+  requires requires(Table& t) { for_each_field(t, [](const Field&, auto&) {}); }
+void visit_value(Io& io, const std::string& at, Table& t) {
+  for_each_field(t, [&](const Field& f, auto& v) {
+    if (f.stored != nullptr && io.version >= f.since) visit_value(io, at + "/" + f.stored, v);
+  });
 }
-void visit_value(auto& io, const std::string& at, BondMaterial& m) {
-  for_each_field(m, [&](const Field& f, auto& v) { visit_value(io, at + "/" + f.stored, v); });
+// The three servos of a motion: at + "0", "1", "2".
+template <class Io>
+void visit_value(Io& io, const std::string& at, std::array<Servo, 3>& servos) {
+  for (int k = 0; k < 3; ++k) visit_value(io, at + std::to_string(k), servos[k]);
 }
 
 template <class Io>
@@ -346,15 +355,7 @@ void visit(Io& io, State& s) {
     io.column(at + "/modes", modes);
     for (int k = 0; k < 3; ++k) m.translation[k] = static_cast<Dof>(modes.at(k));
     m.rotation = static_cast<Dof>(modes.at(3));
-    io.vec(at + "/motion_velocity", m.velocity);
-    io.vec(at + "/motion_angular_velocity", m.angular_velocity);
-    for (int k = 0; k < 3; ++k) {
-      const std::string sv = at + "/servo" + std::to_string(k);
-      for_each_field(m.servo[k], [&](const Field& f, double& v) {
-        if (io.version >= f.since) io.scalar(sv + "/" + f.stored, v);
-      });
-    }
-    if (io.version >= 2) io.scalar(at + "/damping", m.damping);
+    visit_value(io, at, m);  // the rest of the motion, by its table
   }
 }
 
@@ -366,13 +367,20 @@ bool setting_valid(const Field&, const std::string&) { return true; }
 bool setting_valid(const Field&, const Vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
-// A material: every field valid.
-template <class Material>
-  requires std::is_same_v<Material, ContactMaterial> || std::is_same_v<Material, BondMaterial>
-bool setting_valid(const Field&, const Material& m) {
+bool setting_valid(const Field&, Dof d) { return std::uint8_t(d) <= std::uint8_t(Dof::servo); }
+bool setting_valid(const Field& f, const std::array<Dof, 3>& modes) {
+  return setting_valid(f, modes[0]) && setting_valid(f, modes[1]) && setting_valid(f, modes[2]);
+}
+// A struct with a field table (a material, a servo): every field valid.
+template <class Table>
+  requires requires(const Table& t) { for_each_field(t, [](const Field&, const auto&) {}); }
+bool setting_valid(const Field&, const Table& t) {
   bool ok = true;
-  for_each_field(m, [&](const Field& f, const auto& v) { ok = ok && setting_valid(f, v); });
+  for_each_field(t, [&](const Field& f, const auto& v) { ok = ok && setting_valid(f, v); });
   return ok;
+}
+bool setting_valid(const Field& f, const std::array<Servo, 3>& servos) {
+  return setting_valid(f, servos[0]) && setting_valid(f, servos[1]) && setting_valid(f, servos[2]);
 }
 
 // Everything a step or a reader relies on, checked after loading: sizes of the columns, indices
@@ -525,15 +533,10 @@ void validate(const State& s, const std::string& path) {
              finite3(grp.servo_origin) && finite3(grp.servo_integral),
          "group " + std::to_string(g) + " state");
     const GroupMotion& m = grp.motion;
-    for (Dof d : {m.translation[0], m.translation[1], m.translation[2], m.rotation})
-      need(std::uint8_t(d) <= std::uint8_t(Dof::servo), "group " + std::to_string(g) + " modes");
-    need(m.rotation != Dof::servo && finite3(m.velocity) && finite3(m.angular_velocity) && finite(m.damping) &&
-             m.damping < 1,
-         "group " + std::to_string(g) + " motion");
-    for (const Servo& sv : m.servo)
-      for_each_field(sv, [&](const Field& f, double v) {
-        need(f.range.contains(v), "group " + std::to_string(g) + " servo " + f.name);
-      });
+    for_each_field(m, [&](const Field& f, const auto& v) {
+      need(setting_valid(f, v), "group " + std::to_string(g) + " motion: " + f.name);
+    });
+    need(m.rotation != Dof::servo, "group " + std::to_string(g) + " motion: rotation");
   }
 }
 

@@ -130,10 +130,10 @@ void push_servo(lua_State* L, const Servo& s) {
   });
 }
 
-// motion = {translation = "free"|"fixed"|"velocity"|"servo" or one per axis, velocity = vec,
-//           servo = {target_force=, stiffness=, gain=, relaxation=, max_velocity=, integral_time=} (for every
-//           servo axis) or three such tables, rotation = "free"|"fixed"|"velocity",
-//           angular_velocity = vec}
+// A motion table (the fields of GroupMotion's table, world.hpp), read by the rules between its
+// fields: translation one mode for all axes or three; a velocity alone prescribes the
+// translation, an angular velocity alone the rotation; servo one table (servo_fields) for every
+// servo axis, or three.
 GroupMotion motion_arg(lua_State* L, int index, const std::string& context, int arg,
                        GroupMotion m) {
   Options o(L, index, context, arg);
@@ -192,28 +192,30 @@ GroupMotion motion_arg(lua_State* L, int index, const std::string& context, int 
   return m;
 }
 
+// A motion's field as Lua shows it: modes by name, vectors {x, y, z}, servos as tables.
+void push_field(lua_State* L, Dof d) { lua_pushstring(L, dof_name(d)); }
+void push_field(lua_State* L, const std::array<Dof, 3>& modes) {
+  lua_createtable(L, 3, 0);
+  for (int k = 0; k < 3; ++k) {
+    push_field(L, modes[static_cast<std::size_t>(k)]);
+    lua_rawseti(L, -2, k + 1);
+  }
+}
+void push_field(lua_State* L, const Vec3& v) { push_vec(L, v); }
+void push_field(lua_State* L, double v) { lua_pushnumber(L, v); }
+void push_field(lua_State* L, const std::array<Servo, 3>& servos) {
+  lua_createtable(L, 3, 0);
+  for (int k = 0; k < 3; ++k) {
+    push_servo(L, servos[static_cast<std::size_t>(k)]);
+    lua_rawseti(L, -2, k + 1);
+  }
+}
 void push_motion(lua_State* L, const GroupMotion& m) {
-  lua_createtable(L, 0, 4);
-  lua_createtable(L, 3, 0);
-  for (int k = 0; k < 3; ++k) {
-    lua_pushstring(L, dof_name(m.translation[static_cast<std::size_t>(k)]));
-    lua_rawseti(L, -2, k + 1);
-  }
-  lua_setfield(L, -2, "translation");
-  push_vec(L, m.velocity);
-  lua_setfield(L, -2, "velocity");
-  lua_createtable(L, 3, 0);
-  for (int k = 0; k < 3; ++k) {
-    push_servo(L, m.servo[static_cast<std::size_t>(k)]);
-    lua_rawseti(L, -2, k + 1);
-  }
-  lua_setfield(L, -2, "servo");
-  lua_pushstring(L, dof_name(m.rotation));
-  lua_setfield(L, -2, "rotation");
-  push_vec(L, m.angular_velocity);
-  lua_setfield(L, -2, "angular_velocity");
-  lua_pushnumber(L, m.damping);
-  lua_setfield(L, -2, "damping");
+  lua_createtable(L, 0, 6);
+  for_each_field(m, [&](const Field& f, const auto& v) {
+    push_field(L, v);
+    lua_setfield(L, -2, f.name);
+  });
 }
 
 int world_add_group(lua_State* L) {
@@ -320,17 +322,39 @@ int world_group_count(lua_State* L) {
   });
 }
 
+// A motion field's default as help() shows it.
+std::string motion_default(Dof d) { return std::string("\"") + dof_name(d) + "\""; }
+std::string motion_default(const std::array<Dof, 3>& m) {
+  return "{" + motion_default(m[0]) + ", " + motion_default(m[1]) + ", " + motion_default(m[2]) + "}";
+}
+std::string motion_default(const Vec3& v) {
+  return "{" + short_number_text(v.x) + ", " + short_number_text(v.y) + ", " + short_number_text(v.z) + "}";
+}
+std::string motion_default(double v) { return short_number_text(v); }
+std::string motion_default(const std::array<Servo, 3>&) { return "{...}"; }
+
+// The motion's fields from their table (world.hpp), one line each.
+std::string motion_fields_help() {
+  std::string t;
+  const GroupMotion defaults;
+  for_each_field(defaults, [&](const Field& f, const auto& v) {
+    t += std::string("\n    ") + f.name + " = " + motion_default(v);
+    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, double>) t += " in " + range_text(f.range);
+    t += std::string(": ") + f.doc;
+  });
+  return t;
+}
+
 // add_group's help: the motion table, and the servo's fields from their table (world.hpp).
 const char* add_group_help() {
   static const std::string text =
       "A rigid group of particles: a list of ids, or function(id, pos, r) returning true for\n"
-      "members. motion = {translation = \"free\"|\"fixed\"|\"velocity\"|\"servo\" (or one per\n"
-      "axis), velocity = v, servo = {...} (for every servo axis, or three of them), rotation =\n"
-      "\"fixed\"|\"free\"|\"velocity\", angular_velocity = w, damping = local damping of the free axes\n"
-      "(default: the world's; 0 for a dead-load platen)}. Default: free translation, no rotation.\n"
-      "Giving velocity alone prescribes it. A servo axis moves at clamp(G (F - F_target),\n"
-      "max_velocity) with F the particles' force on the group along it; its fields (default:\n"
-      "meaning):" + servo_fields_help();
+      "members, moving as `motion` says (fields not given keep their defaults; translation is one\n"
+      "mode for all axes or three; a velocity alone prescribes it, an angular velocity alone the\n"
+      "rotation; servo is one table for every servo axis or three). Its fields (default: meaning):" +
+      motion_fields_help() +
+      "\nA servo axis moves at clamp(G (F - F_target), max_velocity) with F the particles' force on\n"
+      "the group along it; its fields:" + servo_fields_help();
   return text.c_str();
 }
 

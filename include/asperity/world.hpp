@@ -177,6 +177,28 @@ struct GroupMotion {
   double damping = -1;
 };
 
+// visit(field, member) for each field of a group motion: checked when a motion is set, pushed to
+// Lua, saved by a checkpoint, listed by help(). The modes (translation per axis, rotation) are
+// kept together in a checkpoint's `modes` column, hence not `stored` here; the rules between
+// fields (a servo only on servo axes, no servo rotation; in Lua, a velocity alone sets the
+// velocity mode) are written where they apply.
+template <class M, class Visit>
+  requires std::is_same_v<std::remove_const_t<M>, GroupMotion>
+void for_each_field(M& m, Visit&& visit) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  visit(Field{"translation", nullptr, 1, {}, "per axis: free, fixed, velocity (prescribed) or servo (force control)"},
+        m.translation);
+  visit(Field{"velocity", "motion_velocity", 1, {}, "m/s, on the velocity axes"}, m.velocity);
+  visit(Field{"servo", "servo", 1, {}, "per axis, used on the servo axes (fields below)"}, m.servo);
+  visit(Field{"rotation", nullptr, 1, {}, "the three rotational axes together: fixed, free or velocity"},
+        m.rotation);
+  visit(Field{"angular_velocity", "motion_angular_velocity", 1, {}, "rad/s, when rotation is velocity"},
+        m.angular_velocity);
+  visit(Field{"damping", "damping", 2, {-inf, 1, true, true},
+              "local damping of the free axes; negative: the world's (0 for a dead-load platen)"},
+        m.damping);
+}
+
 struct ContactInfo {  // one ball-ball contact (touching pair), for inspection and output
   std::int64_t id_a, id_b;
   Vec3 normal;         // unit, from a to b
