@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "bodies/groups.hpp"
+#include "field_problems.hpp"
 #include "bodies/mesh.hpp"
 #include "kernels/bond_law.hpp"
 #include "kernels/bonds.hpp"
@@ -31,21 +32,20 @@ void require(bool ok, const std::string& message) {
   if (!ok) throw Error(message);
 }
 
-std::string num(double v) {
-  if (std::isnan(v)) return "nan";  // not "-nan": the sign of a NaN means nothing to a user
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
+std::string num(double v) { return short_number_text(v); }
 
 std::string vec_text(const Vec3& v) {
   return "(" + num(v.x) + ", " + num(v.y) + ", " + num(v.z) + ")";
 }
 
-void require_finite(const Vec3& v, const char* what) {
-  require(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z),
-          std::string(what) + " must be finite, got " + vec_text(v));
+// A value against its field (field_problems.hpp): `where` names the call, e.g. "set_dt_safety: ".
+template <class T>
+void check_value(const std::string& where, const Field& f, const T& v) {
+  const std::string problem = detail::field_problem(f, v);
+  require(problem.empty(), where + problem);
 }
+
+void require_finite(const Vec3& v, const char* what) { check_value("", Field{what}, v); }
 
 // Positions (particles, plane points, mesh vertices) within kMaxCoordinate of the origin: the
 // cell grids take differences of coordinates, which must not overflow.
@@ -62,36 +62,8 @@ void require_radius(double r, const std::string& what) {
           what + " " + num(r) + " outside [" + num(kMinRadius) + ", " + num(kMaxRadius) + "] m");
 }
 
-void require_density(double rho, const std::string& what) {
-  require(rho >= kMinDensity && rho <= kMaxDensity,
-          what + " " + num(rho) + " outside [" + num(kMinDensity) + ", " + num(kMaxDensity) +
-              "] kg/m^3");
-}
-
-// A value against its field (fields.hpp): `where` names the call, e.g. "set_dt_safety: ".
-void check_value(const std::string& where, const Field& f, double v) {
-  const std::string problem = range_problem(f.name, v, f.range);
-  require(problem.empty(), where + problem);
-}
-void check_value(const std::string& where, const Field& f, int v) { check_value(where, f, double(v)); }
-void check_value(const std::string&, const Field&, bool) {}
-void check_value(const std::string&, const Field&, const std::string&) {}  // simd: by the kernel registry
-void check_value(const std::string& where, const Field& f, const Vec3& v) {
-  require_finite(v, (where + f.name).c_str());
-}
-void check_value(const std::string& where, const Field& f, Dof d) {
-  require(d == Dof::free || d == Dof::fixed || d == Dof::velocity || d == Dof::servo,
-          where + "unknown " + f.name + " mode");
-}
-void check_value(const std::string& where, const Field& f, const std::array<Dof, 3>& modes) {
-  for (Dof d : modes) check_value(where, f, d);
-}
-void check_value(const std::string&, const Field&, const std::array<Servo, 3>&) {}  // per servo axis, below
 void check_material(const ContactMaterial& m, const std::string& where) {
-  for_each_field(m, [&](const Field& f, double v) { check_value(where + ": ", f, v); });
-}
-void check_value(const std::string& where, const Field& f, const ContactMaterial& m) {
-  check_material(m, where + f.name);
+  check_value("", Field{where.c_str()}, m);
 }
 // The field of WorldSettings called `name`.
 Field setting_field(const char* name) {
@@ -211,7 +183,7 @@ std::int64_t World::add_particles(std::span<const double> xyz, std::span<const d
                                               " radii (expected 3 per particle)");
   // density <= 0 means the default; NaN is not "<= 0" and is refused with the rest.
   const double rho = density <= 0 ? s.settings.density : density;
-  require_density(rho, "add_particle: density");
+  check_setting("add_particle", "density", rho);
   for (std::size_t k = 0; k < radii.size(); ++k) {
     const std::string which = radii.size() > 1 ? " of particle " + std::to_string(k + 1) : "";
     require_radius(radii[k], "add_particle: radius" + which);
@@ -668,7 +640,7 @@ World::ContactStress World::contact_stress(int tag, double volume) const {
 std::size_t World::install_bonds(const BondMaterial& material, double tolerance,
                                  std::span<const std::int64_t> ids, bool stress_free) {
   State& s = *state_;
-  for_each_field(material, [](const Field& f, const auto& v) { check_value("bond material: ", f, v); });
+  check_value("", Field{"bond material"}, material);
   require(!material.breakable || material.tensile_strength > 0,
           "bond material: a breakable bond needs tensile_strength > 0 (Pa), got " +
               num(material.tensile_strength) + "; set breakable = false for unbreakable bonds");

@@ -18,6 +18,7 @@
 #include "asperity/io.hpp"
 #include "bodies/groups.hpp"
 #include "bodies/mesh.hpp"
+#include "field_problems.hpp"
 #include "io/hdf5_file.hpp"
 #include "kernels/bonds.hpp"
 #include "neighbor/build.hpp"
@@ -359,28 +360,10 @@ void visit(Io& io, State& s) {
   }
 }
 
-// Whether a stored setting holds a value its field accepts (world.hpp, for_each_setting).
-bool setting_valid(const Field& f, double v) { return f.range.contains(v); }
-bool setting_valid(const Field& f, int v) { return f.range.contains(v); }
-bool setting_valid(const Field&, bool) { return true; }
-bool setting_valid(const Field&, const std::string&) { return true; }
-bool setting_valid(const Field&, const Vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-bool setting_valid(const Field&, Dof d) { return std::uint8_t(d) <= std::uint8_t(Dof::servo); }
-bool setting_valid(const Field& f, const std::array<Dof, 3>& modes) {
-  return setting_valid(f, modes[0]) && setting_valid(f, modes[1]) && setting_valid(f, modes[2]);
-}
-// A struct with a field table (a material, a servo): every field valid.
-template <class Table>
-  requires requires(const Table& t) { for_each_field(t, [](const Field&, const auto&) {}); }
-bool setting_valid(const Field&, const Table& t) {
-  bool ok = true;
-  for_each_field(t, [&](const Field& f, const auto& v) { ok = ok && setting_valid(f, v); });
-  return ok;
-}
-bool setting_valid(const Field& f, const std::array<Servo, 3>& servos) {
-  return setting_valid(f, servos[0]) && setting_valid(f, servos[1]) && setting_valid(f, servos[2]);
+// Whether a stored value is one its field accepts (field_problems.hpp).
+template <class T>
+bool setting_valid(const Field& f, const T& v) {
+  return detail::field_problem(f, v).empty();
 }
 
 // Everything a step or a reader relies on, checked after loading: sizes of the columns, indices
@@ -536,6 +519,8 @@ void validate(const State& s, const std::string& path) {
     for_each_field(m, [&](const Field& f, const auto& v) {
       need(setting_valid(f, v), "group " + std::to_string(g) + " motion: " + f.name);
     });
+    for (const Servo& sv : m.servo)  // every axis's, used or not: the file holds all three
+      need(setting_valid(Field{"servo"}, sv), "group " + std::to_string(g) + " motion: servo");
     need(m.rotation != Dof::servo, "group " + std::to_string(g) + " motion: rotation");
   }
 }
