@@ -99,6 +99,16 @@ void read_option(lua_State* L, Options& o, const Field& f, ContactMaterial& v) {
   v = material_field(L, o, f.name, v);
 }
 
+const char* dof_name(Dof d) {
+  switch (d) {
+    case Dof::free: return "free";
+    case Dof::fixed: return "fixed";
+    case Dof::velocity: return "velocity";
+    case Dof::servo: return "servo";
+  }
+  return "?";
+}
+
 namespace {
 
 void push_value(lua_State* L, double v) { lua_pushnumber(L, v); }
@@ -116,6 +126,11 @@ std::string default_text(const std::string& v) { return "\"" + v + "\""; }
 std::string default_text(const Vec3& v) {
   return "{" + short_number_text(v.x) + ", " + short_number_text(v.y) + ", " + short_number_text(v.z) + "}";
 }
+std::string default_text(Dof d) { return std::string("\"") + dof_name(d) + "\""; }
+std::string default_text(const std::array<Dof, 3>& m) {
+  return "{" + default_text(m[0]) + ", " + default_text(m[1]) + ", " + default_text(m[2]) + "}";
+}
+std::string default_text(const std::array<Servo, 3>&) { return "{...}"; }
 std::string default_text(const ContactMaterial& m) {
   std::string t;
   for_each_field(m, [&](const Field& f, double v) {
@@ -145,21 +160,19 @@ const char* world_settings_help() {
   return text.c_str();
 }
 
-}  // namespace
-
-std::string servo_fields_help() {
+// The fields of a struct with a table, at their defaults, one line each.
+template <class Table>
+std::string fields_help(const Table& defaults) {
   std::string t;
-  const Servo defaults;
-  for_each_field(defaults, [&](const Field& f, double v) { t += field_line(f, v, "    "); });
-  return t;
-}
-
-std::string bond_material_fields_help() {
-  std::string t;
-  const BondMaterial defaults;
   for_each_field(defaults, [&](const Field& f, const auto& v) { t += field_line(f, v, "    "); });
   return t;
 }
+
+}  // namespace
+
+std::string servo_fields_help() { return fields_help(Servo{}); }
+std::string bond_material_fields_help() { return fields_help(BondMaterial{}); }
+std::string motion_fields_help() { return fields_help(GroupMotion{}); }
 
 namespace {
 

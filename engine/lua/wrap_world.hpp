@@ -28,9 +28,11 @@ void read_option(lua_State* L, Options& o, const Field& f, bool& v);
 void read_option(lua_State* L, Options& o, const Field& f, std::string& v);
 void read_option(lua_State* L, Options& o, const Field& f, Vec3& v);
 void read_option(lua_State* L, Options& o, const Field& f, ContactMaterial& v);
-// The help lines of the servo's and the bond material's fields, from their tables.
+const char* dof_name(Dof d);  // "free", "fixed", "velocity", "servo"
+// The help lines of the servo's, the bond material's and a group motion's fields, from their tables.
 std::string servo_fields_help();
 std::string bond_material_fields_help();
+std::string motion_fields_help();
 // Particles named by a list of ids (table or Array) or by a predicate function(id, pos, r).
 std::vector<std::int64_t> ids_arg(lua_State* L, int arg, const World& w, const char* context);
 

@@ -105,16 +105,6 @@ Dof dof_from_name(const std::string& name, const std::string& where) {
   throw Error(where + ": unknown motion '" + name + "' (valid: free, fixed, velocity, servo)");
 }
 
-const char* dof_name(Dof d) {
-  switch (d) {
-    case Dof::free: return "free";
-    case Dof::fixed: return "fixed";
-    case Dof::velocity: return "velocity";
-    case Dof::servo: return "servo";
-  }
-  return "?";
-}
-
 Servo servo_fields(lua_State* L, int index, const std::string& context, Servo s) {
   Options o(L, index, context, 0);
   for_each_field(s, [&](const Field& f, double& v) { v = o.number(f.name, v); });
@@ -320,29 +310,6 @@ int world_group_count(lua_State* L) {
     lua_pushinteger(L, static_cast<lua_Integer>(world_arg(L).group_count()));
     return 1;
   });
-}
-
-// A motion field's default as help() shows it.
-std::string motion_default(Dof d) { return std::string("\"") + dof_name(d) + "\""; }
-std::string motion_default(const std::array<Dof, 3>& m) {
-  return "{" + motion_default(m[0]) + ", " + motion_default(m[1]) + ", " + motion_default(m[2]) + "}";
-}
-std::string motion_default(const Vec3& v) {
-  return "{" + short_number_text(v.x) + ", " + short_number_text(v.y) + ", " + short_number_text(v.z) + "}";
-}
-std::string motion_default(double v) { return short_number_text(v); }
-std::string motion_default(const std::array<Servo, 3>&) { return "{...}"; }
-
-// The motion's fields from their table (world.hpp), one line each.
-std::string motion_fields_help() {
-  std::string t;
-  const GroupMotion defaults;
-  for_each_field(defaults, [&](const Field& f, const auto& v) {
-    t += std::string("\n    ") + f.name + " = " + motion_default(v);
-    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, double>) t += " in " + range_text(f.range);
-    t += std::string(": ") + f.doc;
-  });
-  return t;
 }
 
 // add_group's help: the motion table, and the servo's fields from their table (world.hpp).
