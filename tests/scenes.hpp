@@ -1,12 +1,23 @@
-// Small scenes shared by the core tests.
+// Small scenes and helpers shared by the engine's tests.
 #pragma once
 #include <cstdint>
 #include <random>
+#include <string>
 #include <utility>
 
 #include "asperity/world.hpp"
 
 namespace asperity::test {
+
+// The message of the Error that `call` throws; "(no error)" when it throws none.
+inline std::string error_of(auto&& call) {
+  try {
+    call();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
 
 // Particles (a, b) of pair k of `pairs` in the random inputs of the SIMD-vs-scalar kernel tests.
 // Separate: every pair has its own two particles, 2k and 2k + 1 (the a-side is gathered). Shared:

@@ -674,14 +674,7 @@ TEST(Bonds, ABadBondMaterialIsRefusedByNameAndNothingIsInstalled) {
   World w;
   w.add_particle({0, 0, 0}, kR);
   w.add_particle({0, 0, 2 * kR}, kR);
-  auto error_of = [&](const BondMaterial& m) {
-    try {
-      w.install_bonds(m);
-    } catch (const Error& e) {
-      return std::string(e.what());
-    }
-    return std::string("(no error)");
-  };
+  auto error_of = [&](const BondMaterial& m) { return test::error_of([&] { w.install_bonds(m); }); };
   BondMaterial bad;
   bad.beam_kn = -1;
   bad.tensile_strength = 1;

@@ -5,9 +5,11 @@
 #include <cmath>
 #include <limits>
 
+#include "scenes.hpp"
 #include "state.hpp"
 
 using namespace asperity;
+using asperity::test::error_of;
 
 namespace {
 World pair_of_spheres() {
@@ -15,14 +17,6 @@ World pair_of_spheres() {
   w.add_particle({0, 0, 0}, 1e-3);
   w.add_particle({1.9e-3, 0, 0}, 1e-3);
   return w;
-}
-std::string error_of(auto&& call) {
-  try {
-    call();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
 }
 }  // namespace
 
