@@ -194,12 +194,8 @@ function M.run(run)
     factor = f
     if factor > run.speedup_max then run.speedup_max = factor end
     run.speedup_from = run.speedup_from or run:displacement()
-    if servo_control then
-      world:set_group_motion(top, {servo = {target_force = run.target_stress * area, stiffness = cns_stiffness,
-                                            max_velocity = P.servo_max_velocity * factor * P.velocity,
-                                            relaxation = P.servo_relaxation,
-                                            integral_time = P.servo_integral_steps * world:dt()}})
-    end
+    -- The servo's other fields are kept, and with them its CNS origin and integral.
+    if servo_control then world:set_group_motion(top, {servo = {max_velocity = P.servo_max_velocity * factor * P.velocity}}) end
     set_shear_velocity(stage)
   end
   if cns_stiffness > 0 then world:set_group_motion(top, {servo = {stiffness = cns_stiffness}}) end
