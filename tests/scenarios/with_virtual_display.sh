@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Runs a command on a private virtual X server (Xvfb), for ParaView's renderer on a machine
+# without a display. Xvfb picks a free display itself and writes its number to a pipe only once
+# it accepts connections (-displayfd), so the command never starts before the server is ready and
+# two runs never race for the same display. A server that fails to start is retried, and its own
+# message is printed if it never does.
+set -u
+if [ $# -lt 1 ]; then
+  echo "usage: $0 COMMAND [ARG...]" >&2
+  exit 2
+fi
+
+work=$(mktemp -d)
+server=""
+cleanup() {
+  [ -n "$server" ] && kill "$server" 2>/dev/null && wait "$server" 2>/dev/null
+  rm -rf "$work"
+}
+trap cleanup EXIT
+
+display=""
+for attempt in 1 2 3; do
+  mkfifo "$work/ready"
+  Xvfb -displayfd 3 -nolisten tcp -screen 0 1280x1024x24 3>"$work/ready" 2>"$work/xvfb.log" &
+  server=$!
+  # The read ends when Xvfb writes its display number, or with nothing when it exits first.
+  read -r -t 30 display <"$work/ready" || display=""
+  rm -f "$work/ready"
+  if [ -n "$display" ] && kill -0 "$server" 2>/dev/null; then
+    break
+  fi
+  kill "$server" 2>/dev/null
+  wait "$server" 2>/dev/null
+  server=""
+  display=""
+done
+if [ -z "$display" ]; then
+  echo "$0: Xvfb did not start in 3 attempts; its last message:" >&2
+  cat "$work/xvfb.log" >&2
+  exit 1
+fi
+
+DISPLAY=":$display" "$@"
