@@ -201,10 +201,12 @@ local function build(run)
 end
 
 -- The specimen of run.surface, from the cache or built (and cached): sets run.cache_file,
--- run.world and run.genesis_record and returns true; with stop_after=packing, sets the short
+-- run.world, run.genesis_record, run.specimen_packed (built by this run) and run.specimen_seconds
+-- (packing, bonding and relaxing; or loading) and returns true; with stop_after=packing, sets the short
 -- record and returns false.
 function M.specimen(run)
   local P = run.P
+  local t0 = asperity.wall_time()
   run.cache_file = cache_file(P, run.surface)
   -- The record is written last: a specimen without one was cut short and is built again.
   local f = io.open(run.cache_file .. ".lua", "r")
@@ -217,10 +219,12 @@ function M.specimen(run)
     run:log("reusing the cached specimen %s", run.cache_file)
     run.world = asperity.load(run.cache_file, {threads = P.threads, simd = P.simd})
     run.genesis_record = dofile(run.cache_file .. ".lua")
+    run.specimen_packed, run.specimen_seconds = false, asperity.wall_time() - t0
     return true
   end
   run.world, run.genesis_record = build(run)
   if not run.world then return false end   -- stop_after = "packing"
+  run.specimen_packed, run.specimen_seconds = true, asperity.wall_time() - t0
   if P.simd ~= "auto" then run.world = asperity.load(run.cache_file, {threads = P.threads, simd = P.simd}) end
   return true
 end

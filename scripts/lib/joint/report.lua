@@ -246,6 +246,8 @@ function M.write(run)
     dt = world:dt(),
     wall_seconds = asperity.wall_time() - run.t_start,
     specimen_cache = run.cache_file,
+    specimen_packed = run.specimen_packed,   -- packed by this run (its wall time includes the genesis)
+    specimen_seconds = run.specimen_seconds, -- the genesis (packed, bonded, relaxed) or the cache's loading
     genesis = run.genesis_record,
   }
   asperity.write_json(P.out .. "/summary.json", summary)
