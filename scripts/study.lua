@@ -26,7 +26,7 @@ local params_lib = require("params")
 -- What the runner sets on every joint.lua command line itself: not to be given again through `joint`.
 local RESERVED = {surface = true, stress = true, direction = true, model = true, seed = true, out = true,
                   threads = true, cache = true, size = true, progress = true, normal_control = true,
-                  normal_stiffness = true, events_every = true}
+                  normal_stiffness = true, events_every = true, speedup = true}
 -- The ones the study varies, each with the study's own list parameter.
 local VARIED = {surface = "surfaces", stress = "stresses", direction = "directions", model = "models", seed = "seeds"}
 
@@ -46,6 +46,9 @@ local P = params_lib.parse{
   {"size", 0, unit = "m", min = 0, doc = "side of the joints (0: joint.lua's default)"},
   {"normal_stiffness", 0, unit = "MPa/mm", min = 0,
    doc = "> 0: every run under constant normal stiffness (normal_control=stiffness); 0: constant normal load"},
+  {"speedup", 1, type = "integer", oneof = {1, 2, 4},
+   doc = "joint.lua's speedup for the rigid and elastic runs (the loading rate may rise to this factor " ..
+   "after the peak); the fracture runs keep 1, their results depend on the loading rate"},
   {"events_every", 100, type = "integer", unit = "steps", min = 0,
    doc = "between the energy samples of the fracture runs, for the event statistics (0: none)"},
   {"joint", "", doc = "more key=value parameters for every joint.lua run, space-separated (not those the study sets)"},
@@ -160,6 +163,7 @@ local function command(run)
     args[#args + 1] = "normal_control=stiffness"
     args[#args + 1] = "normal_stiffness=" .. number_text(P.normal_stiffness)
   end
+  if run.model ~= "fracture" and P.speedup > 1 then args[#args + 1] = "speedup=" .. P.speedup end
   if run.model == "fracture" and P.events_every > 0 then args[#args + 1] = "events_every=" .. P.events_every end
   for _, item in ipairs(extra) do args[#args + 1] = item end
   args[#args + 1] = "threads=" .. threads
@@ -392,14 +396,18 @@ write_atomic(DIR .. "/.study/run.sh", RUN_SH)
 -- invocation with other settings would skip runs made differently and mix them in one table.
 do
   local settings = {size = P.size, joint = table.concat(extra, " "), normal_stiffness = P.normal_stiffness,
-                    events_every = P.events_every}
+                    events_every = P.events_every, speedup = P.speedup}
+  -- what a folder written before a setting existed was made with
+  local made_without = {speedup = 1}
   local path = DIR .. "/.study/settings.json"
   if exists(path) then
     local before = json.read(path)
-    for _, k in ipairs{"size", "joint", "normal_stiffness", "events_every"} do
-      if before[k] ~= settings[k] then
+    for _, k in ipairs{"size", "joint", "normal_stiffness", "events_every", "speedup"} do
+      local was = before[k]
+      if was == nil then was = made_without[k] end
+      if was ~= settings[k] then
         fail("%s holds a study made with %s=%s, not %s: give another out= (or the same %s)", DIR, k,
-             tostring(before[k]), tostring(settings[k]), k)
+             tostring(was), tostring(settings[k]), k)
       end
     end
   else
