@@ -104,6 +104,8 @@ local P = params_lib.parse{
   {"out", "out/joint", nonempty = true, doc = "output folder (created when the run starts writing)"},
   {"cache", "", doc = "folder of cached specimens (\"\": $ASPERITY_CACHE, else ~/.cache/asperity, else out/cache)"},
   {"threads", 0, type = "integer", min = 0, doc = "0: automatic"},
+  {"genesis_threads", 0, type = "integer", min = 0,
+   doc = "threads of the genesis, when this run packs the specimen (0: threads); the shear then runs on threads"},
   {"simd", "auto", oneof = {"auto", "scalar", "sse4_2", "avx2", "avx512f"},
    doc = "kernels of closure and shear (auto: the widest this CPU runs)"},
   {"progress", true, doc = "progress line on the terminal"},

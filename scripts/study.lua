@@ -163,6 +163,7 @@ local function command(run)
     args[#args + 1] = "normal_control=stiffness"
     args[#args + 1] = "normal_stiffness=" .. number_text(P.normal_stiffness)
   end
+  if run.genesis_threads then args[#args + 1] = "genesis_threads=" .. run.genesis_threads end
   if run.model ~= "fracture" and P.speedup > 1 then args[#args + 1] = "speedup=" .. P.speedup end
   if run.model == "fracture" and P.events_every > 0 then args[#args + 1] = "events_every=" .. P.events_every end
   for _, item in ipairs(extra) do args[#args + 1] = item end
@@ -575,14 +576,39 @@ local function overall_left()
   return "about " .. clock(total / jobs) .. " left"
 end
 
+-- How many runs could start now besides `run`: those whose specimen is ready, and one packer per
+-- group neither ready nor busy.
+local function startable_besides(run)
+  local busy = {[run.group] = true}
+  for _, job in pairs(running) do busy[job.run.group] = true end
+  local n = 0
+  for _, r in ipairs(pending) do
+    if ready[r.group] then
+      n = n + 1
+    elseif not busy[r.group] then
+      busy[r.group], n = true, n + 1
+    end
+  end
+  return n
+end
+
 local function start(run, packs)
+  -- A packer whose packing leaves job slots idle (every other run waits for its specimen) packs
+  -- on those slots' cores too; its shear runs on `threads` (results do not depend on the count).
+  if packs then
+    local idle = jobs - started_count() - 1 - startable_besides(run)
+    local more = math.min(math.max(cores, threads), threads * (1 + math.max(0, idle)))
+    if more > threads then run.genesis_threads = more end
+  end
   local line = ("sh %s %s %d %d %s >/dev/null 2>&1 & echo $!"):format(shell_quote(DIR .. "/.study/run.sh"),
     shell_quote(run.name), my_pid, P.retry and 1 or 0, shell_quote(command(run)))
   local pid = tonumber(capture(line))
   if not pid then fail("could not start the run %s", run.name) end
   running[run.name] = {run = run, pid = pid, t = asperity.wall_time(), packs = packs}
   local e = estimate(run, packs)
-  log("started %s%s%s (%d of %d); %s", run.name, packs and " (packs the specimen)" or "",
+  log("started %s%s%s (%d of %d); %s", run.name,
+      packs and (run.genesis_threads and (" (packs the specimen on %d threads)"):format(run.genesis_threads)
+                 or " (packs the specimen)") or "",
       run.restart and " (again: it was interrupted)" or "", done + started_count(), todo,
       e and ("expected to end at %s (in about %s)"):format(os.date("%H:%M", os.time() + math.floor(e + 0.5)), clock(e))
         or "no estimate yet")

@@ -84,6 +84,18 @@ assert(exists(fdir .. "/plots/broken_bonds_fracture_14_x.png"), "broken bonds of
 local xc = read(fdir .. "/events/xcorr.csv")
 assert(select(2, xc:gsub("\n", "")) == 22, "cross-correlations at lags 0..20")
 
+-- One surface on two jobs: its packer packs on both cores (the other run waits for the specimen),
+-- then shears on one; the run that waited gets no genesis threads.
+local one = out .. "/one"
+status, log = run(("surfaces=S1 stresses=14 directions=x models=rigid,elastic jobs=2 threads=1 size=0.008 " ..
+                   "out='%s' report=false joint='thickness=0.003 shear=1 pack_steps=50000'"):format(one), out .. "/one.log")
+assert(status == 0, "the one-surface study failed:\n" .. log)
+if (tonumber(sh.capture("nproc")) or 1) >= 2 then
+  assert(read(one .. "/S1_14_x_rigid_s1/command.txt"):find(" genesis_threads=2 ", 1, true)
+         and log:find("packs the specimen on 2 threads", 1, true), "the packer packs on both cores:\n" .. log)
+end
+assert(not read(one .. "/S1_14_x_elastic_s1/command.txt"):find("genesis_threads", 1, true), "the waiting run packs nothing")
+assert(json.read(one .. "/S1_14_x_rigid_s1/summary.json").parameters.threads == 1, "the packer shears on one thread")
 -- A rerun does nothing (everything finished) and collect=true rebuilds the same rows.
 status, log = run(args, out .. "/again.log")
 assert(status == 0 and log:find("4 finished before", 1, true) and not log:find("started", 1, true), "rerun:\n" .. log)

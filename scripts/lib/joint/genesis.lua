@@ -67,8 +67,10 @@ local function build(run)
   local P, s = run.P, run.surface
   local Lx, Ly, T, surface_z = s.Lx, s.Ly, P.thickness, s.z
   local function log(fmt, ...) run:log(fmt, ...) end
+  -- Results do not depend on the thread count, so the genesis may use more cores than the shear.
+  local threads = P.genesis_threads > 0 and P.genesis_threads or P.threads
   local w = asperity.world{material = mat.contact, damping = mat.damping, density = mat.density,
-                           threads = P.threads, rotation_lock_bonds = mat.rev.rotation_lock_bonds}
+                           threads = threads, rotation_lock_bonds = mat.rev.rotation_lock_bonds}
   -- Boxes: sides, floor of the lower half, roof of the upper one; the mould between them. Made here
   -- rather than by lib/walls.lua, whose box adds the same planes in another order and through other
   -- points: the cached checkpoint keeps the walls as they were added, so its file would change.
@@ -225,7 +227,11 @@ function M.specimen(run)
   run.world, run.genesis_record = build(run)
   if not run.world then return false end   -- stop_after = "packing"
   run.specimen_packed, run.specimen_seconds = true, asperity.wall_time() - t0
-  if P.simd ~= "auto" then run.world = asperity.load(run.cache_file, {threads = P.threads, simd = P.simd}) end
+  if P.simd ~= "auto" then
+    run.world = asperity.load(run.cache_file, {threads = P.threads, simd = P.simd})
+  else
+    run.world:set_threads(P.threads)
+  end
   return true
 end
 
