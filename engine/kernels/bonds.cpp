@@ -220,15 +220,20 @@ void process_breaks(State& s) {
   s.ctx.bond_block_breaks.clear();
   if (any == 0) return;
   const ParticleStore& p = s.p;
-  BondStore kept;
-  kept.material = q.material;
-  kept.any = q.any;
-  kept.resize(q.n);
-  std::size_t n = 0;
-  std::vector<std::size_t> inherit;
+  // The intact bonds are moved down in place (slot kept <= k: every slot is read before it is
+  // written), so a break step allocates no new store: at thesis scale the bond list is tens of MB,
+  // and fresh pages for it on every break step cost as much as the bond stage.
+  std::size_t kept = 0;
+  // The freed pairs, in bond order (sorted by (a, b) like the bond list they come from), made
+  // while the bond's slot is still intact. A touching one keeps the contact bond's normal and
+  // shear force capped at the friction limit; the others start as the search starts a new pair
+  // (no shear force, the current direction as the previous normal).
+  PairStore freed;
+  std::size_t nfreed = 0;
   for (std::size_t k = 0; k < q.n; ++k) {
     if (q.broken[k] == 0) {
-      kept.copy_from(q, k, n++);
+      if (kept != k) q.copy_from(q, k, kept);
+      ++kept;
       continue;
     }
     const auto a = q.a[k], b = q.b[k];
@@ -262,15 +267,9 @@ void process_breaks(State& s) {
     // The pair enters the contact list now (the search never listed it while it was bonded),
     // unless the search never would: two members of one rigid group, or an inert particle.
     const bool listed = !p.inert[a] && !p.inert[b] && (p.group[a] < 0 || p.group[a] != p.group[b]);
-    if (listed) inherit.push_back(k);
-  }
-  // The freed pairs, sorted by (a, b) like the bond list they come from. A touching one keeps the
-  // contact bond's normal and shear force capped at the friction limit; the others start as the
-  // search starts a new pair (no shear force, the current direction as the previous normal).
-  PairStore freed;
-  freed.resize(inherit.size());
-  for (std::size_t t = 0; t < inherit.size(); ++t) {
-    const std::size_t k = inherit[t];
+    if (!listed) continue;
+    const std::size_t t = nfreed++;
+    if (t >= freed.n) freed.resize(std::max<std::size_t>(16, 2 * freed.n));
     freed.a[t] = q.a[k]; freed.b[t] = q.b[k];
     freed.overlap[t] = q.overlap[k];
     if (q.overlap[k] > 0) {
@@ -285,9 +284,8 @@ void process_breaks(State& s) {
       start_pair(freed, t, p);  // the overlap stays the bond's last, as for a touching one
     }
   }
-  kept.n = n;
-  kept.resize(n);
-  q = std::move(kept);
+  freed.resize(nfreed);
+  q.resize(kept);
   refresh_bond_topology(s);
   // Into the pair list without a rebuild: a fracture run breaks bonds on most of its steps, and a
   // rebuild for each would rebuild the list (and reorder the particles) nearly every step.
