@@ -27,10 +27,10 @@ BIN=${BIN:-build/asperity}
 [ -x "$BIN" ] || { echo "$0: $BIN not found: build first (cmake --build build)" >&2; exit 2; }
 mkdir -p "$OUT"
 CACHE=${CACHE:-"$OUT/cache.$$"}
-commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
-git diff --quiet HEAD 2>/dev/null || commit="$commit-dirty"
-cpu=$(grep -m1 "model name" /proc/cpuinfo | sed 's/.*: //')
-csv="perf/results/$(echo "$cpu" | tr 'A-Z' 'a-z' | sed 's/[^a-z0-9]\+/-/g; s/-$//')-joint.csv"
+commit=$(git describe --always --dirty 2>/dev/null || echo unknown)
+source perf/results_file.sh
+cpu=$(cpu_model)
+csv=$(results_file . -joint)
 [ -f "$csv" ] || echo "date,cpu_model,commit,size_m,surface,stress_mpa,model,threads,speedup,particles,genesis_s,setup_s,shear_s,shear_steps,ns_per_particle_step,wall_s,load_avg" > "$csv"
 
 start=$(date +%s)

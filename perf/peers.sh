@@ -38,6 +38,7 @@ done
 
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 repo=$(cd "$here/.." && pwd)
+source "$here/results_file.sh"
 SCENE=${SCENE:-lattice}
 case $SCENE in lattice|bonded) ;; *) echo "peers.sh: unknown SCENE '$SCENE' (lattice or bonded)" >&2; exit 2 ;; esac
 N=${N:-40}
@@ -187,8 +188,7 @@ wait_quiet() {
 }
 
 # --- the runs ----------------------------------------------------------------------------------
-cpu=$(awk -F': *' '/^model name/ { print $2; exit }' /proc/cpuinfo)
-cpu=${cpu:-$(uname -m)}
+cpu=$(cpu_model)
 declare -A best best_cpu rates median bonds
 simd=unknown
 if [[ $SCENE == bonded ]]; then
@@ -293,9 +293,7 @@ for e in $ENGINES; do
 done
 
 mkdir -p "$here/results"
-slug=$(echo "$cpu" | tr 'A-Z' 'a-z' | sed -e 's/([a-z]*)//g' -e 's/[^a-z0-9]\+/-/g' -e 's/^-//' -e 's/-$//')
-csv=$here/results/${slug:-$(hostname)}.csv
-[[ $SCENE == bonded ]] && csv=${csv%.csv}-bonded.csv
+csv=$(results_file "$repo" "$([[ $SCENE == bonded ]] && echo -bonded)")
 [[ -s $csv ]] || echo "date,cpu_model,simd,commit,engine,engine_version,cores,n,particles,steps,particle_steps_per_s,load_avg,particle_steps_per_cpu_s" >"$csv"
 now=$(date -u +%Y-%m-%dT%H:%M:%SZ)
 load=$(cut -d' ' -f1 /proc/loadavg)
