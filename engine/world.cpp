@@ -767,6 +767,7 @@ RunResult World::run(const RunPlan& plan) {
           "run: give steps and/or a stop condition (stop_when or equilibrium)");
   require(plan.every >= 1, "run: every must be >= 1");
   require(plan.ratio > 0, "run: ratio " + num(plan.ratio) + " must be > 0");
+  require(!plan.sample == (plan.sample_every == 0), "run: a sample hook needs sample_every >= 1, and sample_every a hook");
   // A stop request outlives neither the run it ended nor one that failed in a hook.
   struct ForgetStop {
     State& s;
@@ -783,6 +784,7 @@ RunResult World::run(const RunPlan& plan) {
     // per call; they end at every check.
     std::uint64_t n = std::min(chunk, limit - r.steps);
     if (checks) n = std::min(n, every - r.steps % every);
+    if (plan.sample) n = std::min(n, plan.sample_every - r.steps % plan.sample_every);
     const auto t0 = Clock::now();
     const std::uint64_t done = cycle(n);
     r.steps += done;
@@ -793,6 +795,7 @@ RunResult World::run(const RunPlan& plan) {
     const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     if (seconds < 0.02 && chunk < (1u << 20)) chunk *= 2;
     else if (seconds > 0.1 && chunk > 1) chunk /= 2;
+    if (plan.sample && r.steps % plan.sample_every == 0) plan.sample();
     if (checks && r.steps % every == 0) {
       if (plan.callback) plan.callback();
       if (plan.until_equilibrium) {
@@ -873,7 +876,12 @@ void World::rebuild_neighbors() {
 
 // --- measurements --------------------------------------------------------------------------
 
-Energies World::energies() const { return detail::compute_energies(synced(*state_)); }
+// After a step nothing the energies need waits in the lazily moved members (the kinetic energy
+// was summed by the step, the rest is in the stores and the ledger): reading them does not bring
+// the members up to date, which would change how their moves are rounded, and so the run.
+Energies World::energies() const {
+  return detail::compute_energies(state_->kinetic_valid ? *state_ : synced(*state_));
+}
 
 double World::unbalanced_force_ratio() const {
   const State& s = *state_;

@@ -283,6 +283,11 @@ struct RunPlan {
   // After every chunk (chunks are sized to take about 50 ms, cut at the checks): the steps done
   // and the last equilibrium ratio (NaN before the first check). For progress reports.
   std::function<void(std::uint64_t steps, double ratio)> on_chunk;
+  // Every `sample_every` steps of the run (0: never): a hook that only reads the world, such as a
+  // series of energies (World::energies, which moves nothing). Its own cadence, so a fine
+  // series does not make the callback and the stop condition run as often.
+  std::uint64_t sample_every = 0;
+  std::function<void()> sample;
 };
 
 struct RunResult {

@@ -72,7 +72,10 @@ local steps, reason = w:run{steps = 500, every = 50, callback = function() calls
 assert(steps == 500 and reason == "steps" and calls == 10, "run: " .. steps .. " " .. reason .. " " .. calls)
 local n, why = w:run{steps = 1000, every = 10, stop_when = function(w) return w:step() >= 520 end}
 assert(n == 20 and why == "stop_when", n .. " " .. why)
-assert(w:cycle(5) == 5 and w:step() == 525)
+local sampled = {}
+n = w:run{steps = 70, every = 50, sample_every = 20, sample = function(w) sampled[#sampled + 1] = w:step() end}
+assert(n == 70 and #sampled == 3 and sampled[1] == 540 and sampled[3] == 580, "samples at " .. table.concat(sampled, " "))
+assert(w:cycle(5) == 5 and w:step() == 595)
 assert(w:dt() > 0 and w:time() > 0 and w:critical_dt() > 0)
 assert(type(w:simd()) == "string" and w:stats().rebuilds >= 1)
 local e = w:energies()
@@ -106,6 +109,10 @@ local ok, err = pcall(function() return w:add_particle({0, 0}, 0.01) end)
 assert(not ok and err:find("bad argument #1 to 'add_particle'", 1, true), err)
 ok, err = pcall(function() return w:run{steps = 10, stop_when = "forever"} end)
 assert(not ok and err:find("must be a function(world) or \"equilibrium\"", 1, true), err)
+ok, err = pcall(function() return w:run{steps = 10, sample = print} end)
+assert(not ok and err:find("option 'sample' needs sample_every = (steps between samples, >= 1)", 1, true), err)
+ok, err = pcall(function() return w:run{steps = 10, sample_every = 5} end)
+assert(not ok and err:find("option 'sample_every' needs sample = (a function(world))", 1, true), err)
 ok, err = pcall(function() return w:position(99) end)
 assert(not ok and err:find("no particle 99 (valid: 1..5)", 1, true), err)
 ok, err = pcall(function() return w:run{steps = 10, every = 5, callback = function() error("inner") end} end)

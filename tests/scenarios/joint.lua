@@ -86,6 +86,24 @@ assert(fr.broken_bonds > 0, "the fracture model breaks bonds")
 assert(fr.energy_shares and math.abs(fr.energy_balance_error) < 0.01,
        ("fracture: energy balance error %.3g of the input work"):format(fr.energy_balance_error))
 assert(fr.normal_stress_deviation_p95 <= 0.01, "fracture: the servo holds the normal stress")
+-- Sampling the energies for the event statistics (events_every) reads the run without changing it:
+-- a fracture run, chaotic, that samples every 50 steps ends as the one above, break for break.
+local sampled = joint{surface = "S1", model = "fracture", events_every = 50, out = out .. "/S1_fracture_events"}
+local function file(dir, name) local f = assert(io.open(dir .. "/" .. name, "rb")); local t = f:read("a"); f:close(); return t end
+for _, name in ipairs{"shear.csv", "breaks.csv", "closure.csv"} do
+  assert(file(out .. "/S1_fracture_events", name) == file(out .. "/S1_fracture", name),
+         name .. ": the run that sampled its energies differs from the one that did not")
+end
+do  -- a sample every 50 steps from the shear's start to (nearly) its end
+  local steps = {}
+  for line in file(out .. "/S1_fracture_events", "events.csv"):gmatch("[^\n]+") do
+    if not line:find("^step") then steps[#steps + 1] = assert(tonumber(line:match("^([^,]+)")), line) end
+  end
+  for i = 2, #steps do assert(steps[i] - steps[i - 1] == 50, ("events.csv: step %s after %s"):format(steps[i], steps[i - 1])) end
+  assert(50 * (#steps - 1) >= 0.9 * sampled.shear_steps and 50 * (#steps - 1) <= sampled.shear_steps,
+         ("%d energy samples for %d shear steps"):format(#steps, sampled.shear_steps))
+end
+
 -- The shear box (box=sides, the default): the side layers join the platens, except within
 -- box_clearance of the joint, where the halves touch only through bonded particles.
 local free_sides = joint{surface = "S1", model = "elastic", box = "none", shear = 0.2, residual_window = 0.1, snapshots = "",

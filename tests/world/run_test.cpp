@@ -47,6 +47,32 @@ TEST(Run, TheCallbackAndTheStopConditionRunEveryNSteps) {
   EXPECT_EQ(asked, called);
 }
 
+// The sample hook keeps its own cadence, counted from the run's start like the checks, and
+// neither it nor the callback's cadence changes the trajectory.
+TEST(Run, TheSampleHookRunsOnItsOwnCadence) {
+  World w = random_box(60), plain = random_box(60);
+  RunPlan plan;
+  plan.steps = 230;
+  plan.every = 100;
+  std::vector<std::uint64_t> sampled, called;
+  plan.sample_every = 30;
+  plan.sample = [&] { sampled.push_back(w.step_count()); };
+  plan.callback = [&] { called.push_back(w.step_count()); };
+  EXPECT_EQ(w.run(plan).steps, 230u);
+  EXPECT_EQ(sampled, (std::vector<std::uint64_t>{30, 60, 90, 120, 150, 180, 210}));
+  EXPECT_EQ(called, (std::vector<std::uint64_t>{100, 200}));
+  plain.cycle(230);
+  EXPECT_EQ(positions(w), positions(plain));
+
+  RunPlan half;  // a hook without its cadence, or a cadence without its hook
+  half.steps = 10;
+  half.sample = [] {};
+  EXPECT_THROW(w.run(half), Error);
+  half.sample = nullptr;
+  half.sample_every = 5;
+  EXPECT_THROW(w.run(half), Error);
+}
+
 TEST(Run, EquilibriumEndsTheRunAtTheFirstCheckBelowTheRatio) {
   WorldSettings ws;
   ws.local_damping = 0.7;
