@@ -20,6 +20,25 @@ std::vector<std::int64_t> slab(World& w, int n, double z, double R) {
     for (int j = 0; j < n; ++j) ids.push_back(w.add_particle({i * 1.9 * R, j * 1.9 * R, z}, R));
   return ids;  // neighbours overlap by 0.1 R: their contacts must not be computed
 }
+
+// A 3 x 3 slab driven along -x at v towards a free sphere `gap` away; rotation Dof::fixed lets
+// the slab's members that touch nothing move lazily (Dof::velocity at zero: never lazy).
+struct SlabAndBall {
+  std::vector<std::int64_t> slab;
+  std::int64_t ball;
+  int group;
+};
+SlabAndBall slab_driven_at_ball(World& w, double R, double v, double gap, Dof rotation) {
+  SlabAndBall s;
+  s.slab = slab(w, 3, 0, R);
+  s.ball = w.add_particle({-2 * R - gap, 0, 0}, R);
+  GroupMotion m;
+  m.translation = {Dof::velocity, Dof::fixed, Dof::fixed};
+  m.velocity = {-v, 0, 0};
+  m.rotation = rotation;
+  s.group = w.add_group(s.slab, m);
+  return s;
+}
 }  // namespace
 
 TEST(Groups, MemberContactsAreNeverComputed) {
@@ -121,13 +140,7 @@ TEST(Groups, IdleMembersAreFoundWhenSomethingComes) {
   };
   auto run = [&](Dof rotation) {
     World w;
-    const auto ids = slab(w, 3, 0, R);
-    const auto ball = w.add_particle({-2 * R - gap, 0, 0}, R);
-    GroupMotion m;
-    m.translation = {Dof::velocity, Dof::fixed, Dof::fixed};
-    m.velocity = {-v, 0, 0};
-    m.rotation = rotation;  // Dof::velocity at zero angular velocity: never lazy
-    const int g = w.add_group(ids, m);
+    const auto [ids, ball, g] = slab_driven_at_ball(w, R, v, gap, rotation);
     const Vec3 far0 = w.position(ids.back());
     Run r;
     for (int k = 1; k <= 400; ++k) {
@@ -162,12 +175,7 @@ TEST(Groups, ReadingTheEnergiesDoesNotChangeTheRun) {
   const double R = 5e-4, v = 1e-3, gap = 2e-4;
   auto run = [&](bool read) {
     World w;
-    const auto ids = slab(w, 3, 0, R);
-    const auto ball = w.add_particle({-2 * R - gap, 0, 0}, R);
-    GroupMotion m;
-    m.translation = {Dof::velocity, Dof::fixed, Dof::fixed};
-    m.velocity = {-v, 0, 0};
-    w.add_group(ids, m);
+    const auto [ids, ball, g] = slab_driven_at_ball(w, R, v, gap, Dof::fixed);
     double kinetic = 0;
     for (int k = 0; k < 400; ++k) {
       w.cycle(1);
