@@ -9,8 +9,8 @@
 #   SIZE=0.1 perf/joint_end_to_end.sh                         # the thesis's 10 cm
 #   SIZE=0.05 SURFACE=S5 STRESS=21 THREADS=1 OUT=out/e2e perf/joint_end_to_end.sh
 #
-# SPEEDUP (default 4) is passed to the rigid and elastic runs (joint.lua refuses it for the
-# fracture model); EXTRA adds key=value parameters to every run. The specimen is packed by the
+# SPEEDUP (default 4) is passed to the elastic run (joint.lua refuses it for the rigid and
+# fracture models); EXTRA adds key=value parameters to every run. The specimen is packed by the
 # first run into a cache of its own under OUT (a fresh genesis each time, so it is measured);
 # CACHE=DIR reuses a folder instead.
 set -euo pipefail
@@ -36,11 +36,11 @@ csv=$(results_file . -joint)
 start=$(date +%s)
 for model in $MODELS; do
   speed=1
-  [ "$model" != fracture ] && speed=$SPEEDUP
+  [ "$model" = elastic ] && speed=$SPEEDUP
   dir="$OUT/${SURFACE}_${model}"
   echo "== $model (size $SIZE m, $SURFACE, $STRESS MPa, threads $THREADS, speedup $speed)"
   "$BIN" run scripts/joint.lua surface="$SURFACE" size="$SIZE" stress="$STRESS" model="$model" \
-    speedup="$speed" threads="$THREADS" progress=false cache="$CACHE" out="$dir" $EXTRA > "$dir.log" 2>&1 \
+    speedup="$speed" threads="$THREADS" cache="$CACHE" out="$dir" $EXTRA > "$dir.log" 2>&1 \
     || { echo "$model failed: see $dir.log" >&2; tail -3 "$dir.log" >&2; exit 1; }
   tail -1 "$dir.log"
   # The phases from summary.json: the genesis counts only in the run that packed the specimen.

@@ -29,26 +29,41 @@ std::string rate_text(double r) {
 }
 }  // namespace
 
-Progress::Progress(bool wanted, std::uint64_t total_steps)
-    : enabled_(wanted && ::isatty(STDERR_FILENO)), total_(total_steps), start_(Clock::now()),
-      last_(start_) {}
+Progress::Progress(bool wanted, std::uint64_t total_steps, LogCadence log)
+    : terminal_(wanted && ::isatty(STDERR_FILENO)), logging_(wanted && !terminal_), log_(log),
+      total_(total_steps), start_(Clock::now()), last_(start_) {}
 
 Progress::~Progress() {
-  if (drawn_) {
+  if (drawn_ && terminal_) {
     std::fputs("\r\033[K", stderr);
     std::fflush(stderr);
   }
 }
 
 bool Progress::due() {
-  if (!enabled_) return false;
+  if (!terminal_ && !logging_) return false;
   auto now = Clock::now();
-  return std::chrono::duration<double>(now - start_).count() >= kDelay &&
-         (!drawn_ || std::chrono::duration<double>(now - last_).count() >= kInterval);
+  const double delay = terminal_ ? kDelay : log_.first, interval = terminal_ ? kInterval : log_.every;
+  return std::chrono::duration<double>(now - start_).count() >= delay &&
+         (!drawn_ || std::chrono::duration<double>(now - last_).count() >= interval);
 }
 
 void Progress::draw(std::uint64_t done, const std::string& extra, double fraction) {
-  auto now = Clock::now();
+  const auto now = Clock::now();
+  std::string line = text(done, extra, fraction, now);
+  if (logging_) {
+    std::fprintf(stderr, "%s\n", line.c_str());
+    std::fflush(stderr);
+    return;
+  }
+  winsize ws{};
+  if (::ioctl(STDERR_FILENO, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 1 && line.size() >= ws.ws_col)
+    line.resize(ws.ws_col - 1);
+  std::fprintf(stderr, "\r\033[K%s", line.c_str());
+  std::fflush(stderr);
+}
+
+std::string Progress::text(std::uint64_t done, const std::string& extra, double fraction, Clock::time_point now) {
   double since_last = std::chrono::duration<double>(now - last_).count();
   double instant = since_last > 0 ? double(done - last_done_) / since_last : 0;
   rate_ = drawn_ ? 0.7 * rate_ + 0.3 * instant
@@ -88,23 +103,19 @@ void Progress::draw(std::uint64_t done, const std::string& extra, double fractio
   else if (!by_fraction && total_ && rate_ > 0)
     line += "  ETA " + duration_text(double(total_ - done) / rate_);
   if (!extra.empty()) line += "  " + extra;
-  winsize ws{};
-  if (::ioctl(STDERR_FILENO, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 1 && line.size() >= ws.ws_col)
-    line.resize(ws.ws_col - 1);
-  std::fprintf(stderr, "\r\033[K%s", line.c_str());
-  std::fflush(stderr);
+  return line;
 }
 
 void Progress::finish(std::uint64_t done, const std::string& reason) {
   if (drawn_) {
     double elapsed = std::chrono::duration<double>(Clock::now() - start_).count();
-    std::fprintf(stderr, "\r\033[K%llu steps in %s (%s steps/s)%s%s\n", (unsigned long long)done,
-                 duration_text(elapsed).c_str(), rate_text(double(done) / elapsed).c_str(),
-                 reason.empty() ? "" : ", ", reason.c_str());
+    std::fprintf(stderr, "%s%llu steps in %s (%s steps/s)%s%s\n", terminal_ ? "\r\033[K" : "",
+                 (unsigned long long)done, duration_text(elapsed).c_str(),
+                 rate_text(double(done) / elapsed).c_str(), reason.empty() ? "" : ", ", reason.c_str());
     std::fflush(stderr);
     drawn_ = false;
   }
-  enabled_ = false;
+  terminal_ = logging_ = false;
 }
 
 }  // namespace asperity::lua

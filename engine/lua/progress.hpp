@@ -1,8 +1,10 @@
-// The progress line of world:run on stderr.
+// The progress of world:run on stderr.
 //
-// Shown only when stderr is a terminal and the run has lasted more than a couple of seconds, so
-// short runs, tests and logs redirected to files stay quiet. Redrawn at most four times a
-// second; the rate is smoothed so the ETA does not jump.
+// On a terminal: one line, redrawn at most four times a second once the run has lasted a couple
+// of seconds; the rate is smoothed so the ETA does not jump. Into a file or a pipe (a log under
+// nohup, a batch job, a study's run): a plain line now and then, the first after a minute and
+// then every few minutes, and a closing summary if any was written, so a run of hours shows where
+// it is and short runs, tests and scripts' outputs stay quiet.
 #pragma once
 
 #include <chrono>
@@ -11,11 +13,18 @@
 
 namespace asperity::lua {
 
+// When a run whose stderr is not a terminal writes its progress lines (seconds from its start).
+struct LogCadence {
+  double first = 60;
+  double every = 300;
+};
+
 class Progress {
  public:
-  Progress(bool wanted, std::uint64_t total_steps);  // total 0: unknown (no percent, no ETA)
-  ~Progress();  // erases the line (an error is on its way)
-  // Whether a redraw is due now (cheap: one clock read).
+  // total 0: unknown (no percent, no ETA).
+  Progress(bool wanted, std::uint64_t total_steps, LogCadence log = {});
+  ~Progress();  // erases the terminal line (an error is on its way)
+  // Whether a line is due now (cheap: one clock read).
   bool due();
   // `fraction` in [0, 1] (the script's own measure of completion, e.g. sheared / target
   // displacement) replaces done / total when given (>= 0).
@@ -25,7 +34,10 @@ class Progress {
 
  private:
   using Clock = std::chrono::steady_clock;
-  bool enabled_;
+  std::string text(std::uint64_t done, const std::string& extra, double fraction, Clock::time_point now);
+  bool terminal_;  // redraw one line in place
+  bool logging_;   // write a line now and then
+  LogCadence log_;
   bool drawn_ = false;
   std::uint64_t total_;
   Clock::time_point start_, last_;

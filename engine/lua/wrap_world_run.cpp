@@ -249,8 +249,9 @@ std::span<const Function> world_run_methods() {
        "callback(world) are evaluated every `every` steps (100). sample(world) is called every\n"
        "`sample_every` steps, on its own cadence, before the callback when both are due: a fine\n"
        "series (world:energies() reads without changing the run) without checking the stop as\n"
-       "often. A progress line appears on a terminal after 2 s (progress=false: never);\n"
-       "show(world) returns a string or a table of values to add to it; fraction(world) returns\n"
+       "often. A progress line appears on a terminal after 2 s, and in a log (stderr not a\n"
+       "terminal) after 1 minute and then every 5 (progress=false: never); show(world) returns a\n"
+       "string or a table of values to add to it; fraction(world) returns\n"
        "the completion 0..1 for the percent and ETA when stop_when, not steps, ends the run.\n"
        "reason: \"steps\", \"equilibrium\" or \"stop_when\"."},
       {"dt", world_dt, "world:dt() -> s", "The time step in use."},
