@@ -73,9 +73,10 @@ local function verdict(agree, n)
 end
 
 -- Comparisons of `field` between rows that differ only in `vary`, from the `low` to the `high`
--- value of it; `expect` "up" (the field grows with it) or "down".
+-- value of it; `expect` "up" (the field grows with it) or "down". An equal value agrees with
+-- neither; when every pair is equal the factor changed nothing in these runs: untestable.
 local function compare(index, rows, field, vary, pairs_list, expect, filter)
-  local list, agree = {}, 0
+  local list, agree, ties = {}, 0, 0
   for _, a in ipairs(rows) do
     if (not filter or filter(a)) and finite(a[field]) then
       for _, pr in ipairs(pairs_list) do
@@ -85,8 +86,10 @@ local function compare(index, rows, field, vary, pairs_list, expect, filter)
           probe[vary] = pr[2]
           local b = index[key(probe)]
           if b and finite(b[field]) then
-            local ok = (expect == "up") == (b[field] > a[field])
+            local same = b[field] == a[field]
+            local ok = not same and (expect == "up") == (b[field] > a[field])
             if ok then agree = agree + 1 end
+            if same then ties = ties + 1 end
             list[#list + 1] = {low = a.name, high = b.name, low_value = a[field], high_value = b[field],
                                -- a base a thousand times below the other value (a fracture run's
                                -- dilatancy of 0.000 mm) gives no meaningful ratio: left out of the mean
@@ -101,8 +104,12 @@ local function compare(index, rows, field, vary, pairs_list, expect, filter)
   local changes = {}
   for _, c in ipairs(list) do if finite(c.relative_change) then changes[#changes + 1] = c.relative_change end end
   local m, sd = mean_sd(changes)
-  return {verdict = verdict(agree, #list), agree = agree, comparisons = #list, mean_relative_change = m,
-          sd_relative_change = sd, vanishing_bases = #list - #changes, pairs = list}
+  local r = {verdict = verdict(agree, #list), agree = agree, comparisons = #list, mean_relative_change = m,
+             sd_relative_change = sd, vanishing_bases = #list - #changes, ties = ties, pairs = list}
+  if ties > 0 and ties == #list then
+    r.verdict, r.reason = "untestable", "every pair compared gave the same value: the factor changed nothing in these runs"
+  end
+  return r
 end
 
 local function surface_pairs(kind)
@@ -143,22 +150,33 @@ function M.trends(rows, curves)
       compare(index, done, "peak_shear_stress_mpa", "surface", surface_pairs("s2"), "up"), untestable_surface("s2"))
   add("dilatancy_grows_with_variance", "dilatancy grows with the height variance",
       compare(index, done, "max_dilatancy_mm", "surface", surface_pairs("s2"), "up"), untestable_surface("s2"))
+  -- On a joint of side L <= 2 Lc the spectrum's roll-off (chi = 1 / (2 Lc), surfaces.md 2) lies below
+  -- its lowest frequency 1 / L: the surfaces that differ only in Lc are the same surface.
+  local function unresolved_lc(r)
+    if r.verdict == "untestable" and r.comparisons > 0 then
+      r.reason = "the surfaces that differ only in Lc gave identical runs: on a joint of side L <= 2 Lc the " ..
+                 "roll-off 1 / (2 Lc) lies below the lowest frequency 1 / L, so they are the same surface (the " ..
+                 "study's Lc of 16 and 20 mm need joints over 4 cm)"
+    end
+    return r
+  end
   add("peak_falls_with_correlation_length", "peak shear stress falls with the correlation length",
-      compare(index, done, "peak_shear_stress_mpa", "surface", surface_pairs("Lc"), "down"), untestable_surface("Lc"))
+      unresolved_lc(compare(index, done, "peak_shear_stress_mpa", "surface", surface_pairs("Lc"), "down")), untestable_surface("Lc"))
   add("dilatancy_falls_with_correlation_length", "dilatancy falls with the correlation length",
-      compare(index, done, "max_dilatancy_mm", "surface", surface_pairs("Lc"), "down"), untestable_surface("Lc"))
+      unresolved_lc(compare(index, done, "max_dilatancy_mm", "surface", surface_pairs("Lc"), "down")), untestable_surface("Lc"))
   add("peak_grows_as_hurst_falls", "peak shear stress grows as H falls",
       compare(index, done, "peak_shear_stress_mpa", "surface", surface_pairs("H"), "down"), untestable_surface("H"))
   add("dilatancy_grows_as_hurst_falls", "dilatancy grows as H falls",
       compare(index, done, "max_dilatancy_mm", "surface", surface_pairs("H"), "down"), untestable_surface("H"))
-  -- H the strongest: the mean size of the relative change of the peak per statistic.
+  -- H the strongest: the mean size of the relative change of the peak per statistic (a statistic
+  -- whose pairs all gave the same runs, such as Lc on small joints, is left out: not resolved).
   do
     local size = {}
     for _, kind in ipairs{"H", "s2", "Lc"} do
       local c = compare(index, done, "peak_shear_stress_mpa", "surface", surface_pairs(kind), "up")
       local s, n = 0, 0
       for _, p in ipairs(c.pairs) do if finite(p.relative_change) then s, n = s + math.abs(p.relative_change), n + 1 end end
-      size[kind] = n > 0 and s / n or nil
+      size[kind] = n > 0 and c.ties < #c.pairs and s / n or nil
     end
     local r = {comparisons = 0, agree = 0, mean_abs_relative_change = size}
     if size.H and (size.s2 or size.Lc) then
@@ -312,6 +330,7 @@ local function trends_markdown(T, rows)
     if (t.vanishing_bases or 0) > 0 then
       numbers[#numbers + 1] = ("%d with a vanishing base left out of the mean"):format(t.vanishing_bases)
     end
+    if (t.ties or 0) > 0 then numbers[#numbers + 1] = ("%d of them equal (agree with neither)"):format(t.ties) end
     if t.mean_abs_relative_change then
       for _, k in ipairs{"H", "s2", "Lc"} do
         if t.mean_abs_relative_change[k] then

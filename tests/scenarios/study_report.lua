@@ -103,6 +103,32 @@ for _, r in ipairs(rows) do
   if r.surface == "S1" and r.status == "finished" then r.peak_shear_stress_mpa = r.peak_shear_stress_mpa / 10 end
 end
 
+-- Surfaces that differ only in Lc and gave identical runs (a joint no larger than 2 Lc: the same
+-- surface): untestable, with the reason; a pair of equal values agrees with neither direction.
+local lc_rows, lc_curves = {}, {}
+for _, surface in ipairs{"S1", "S3"} do
+  for _, model in ipairs{"rigid", "elastic"} do
+    local name = surface .. "_14_x_" .. model .. "_s1"
+    lc_rows[#lc_rows + 1] = {name = name, status = "finished", surface = surface, H = 0.75, Lc_mm = surface == "S1" and 16 or 20,
+                             s2_mm2 = 0.547, stress_mpa = 14, direction = "x", model = model, seed = 1,
+                             peak_shear_stress_mpa = model == "rigid" and 30 or 32, residual_shear_stress_mpa = 5,
+                             initial_shear_stiffness_mpa_per_mm = 50, max_dilatancy_mm = 1.5, broken_bonds = 0,
+                             contact_decay_exponent = -0.5, energy_shares_friction = 0.9, energy_shares_damping = 0.05}
+    lc_curves[name] = curves["S1_14_x_" .. model .. "_s1"]
+  end
+end
+T = {}
+for _, t in ipairs(report.trends(lc_rows, lc_curves)) do T[t.id] = t end
+expect("peak_falls_with_correlation_length", "untestable", 2)
+assert(T.peak_falls_with_correlation_length.ties == 2 and T.peak_falls_with_correlation_length.reason:find("same surface", 1, true),
+       "identical runs: " .. tostring(T.peak_falls_with_correlation_length.reason))
+assert(T.hurst_strongest.mean_abs_relative_change.Lc == nil, "an unresolved Lc is not a statistic H beats")
+lc_rows[3].peak_shear_stress_mpa = 29  -- S3 rigid below S1 rigid: agrees; the elastic pair stays equal
+T = {}
+for _, t in ipairs(report.trends(lc_rows, lc_curves)) do T[t.id] = t end
+expect("peak_falls_with_correlation_length", "not shown", 2)
+assert(T.peak_falls_with_correlation_length.agree == 1 and T.peak_falls_with_correlation_length.ties == 1, "one agrees, one equal")
+
 -- Mean and sample SD over the seeds: peaks p and 1.1 p.
 local cases = report.cases(rows)
 assert(#cases == 12, ("%d cases, want 12"):format(#cases))
