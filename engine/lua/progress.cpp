@@ -4,7 +4,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 
 namespace asperity::lua {
 
@@ -28,6 +30,22 @@ std::string rate_text(double r) {
   return buf;
 }
 }  // namespace
+
+LogCadence LogCadence::from_environment() {
+  LogCadence c;
+  const char* text = std::getenv("ASPERITY_PROGRESS_EVERY");
+  if (!text || !*text) return c;
+  char* end = nullptr;
+  const double s = std::strtod(text, &end);
+  if (*end == '\0' && s > 0 && std::isfinite(s)) {
+    c.first = c.every = s;
+  } else {
+    static bool said = false;
+    if (!said) std::fprintf(stderr, "asperity: ASPERITY_PROGRESS_EVERY=%s ignored (seconds > 0 expected)\n", text);
+    said = true;
+  }
+  return c;
+}
 
 Progress::Progress(bool wanted, std::uint64_t total_steps, LogCadence log)
     : terminal_(wanted && ::isatty(STDERR_FILENO)), logging_(wanted && !terminal_), log_(log),

@@ -17,6 +17,9 @@ namespace asperity::lua {
 struct LogCadence {
   double first = 60;
   double every = 300;
+  // ASPERITY_PROGRESS_EVERY=S (seconds > 0): a line after S and then every S (a batch job that
+  // wants more or fewer lines); otherwise, or if it is not such a number (said once), the defaults.
+  static LogCadence from_environment();
 };
 
 class Progress {

@@ -132,7 +132,9 @@ int world_run(lua_State* L) {
         return stop;
       };
     plan.interrupted = take_run_interrupt;
-    Progress bar(progress, plan.steps);
+    // With a stop condition the step count is only a cap: no percent or ETA from it (a script's
+    // fraction gives them).
+    Progress bar(progress, stop_type == LUA_TNIL ? plan.steps : 0, LogCadence::from_environment());
     plan.on_chunk = [&](std::uint64_t done, double last_ratio) {
       if (!bar.due()) return;
       std::string extra;
@@ -250,9 +252,10 @@ std::span<const Function> world_run_methods() {
        "`sample_every` steps, on its own cadence, before the callback when both are due: a fine\n"
        "series (world:energies() reads without changing the run) without checking the stop as\n"
        "often. A progress line appears on a terminal after 2 s, and in a log (stderr not a\n"
-       "terminal) after 1 minute and then every 5 (progress=false: never); show(world) returns a\n"
-       "string or a table of values to add to it; fraction(world) returns\n"
-       "the completion 0..1 for the percent and ETA when stop_when, not steps, ends the run.\n"
+       "terminal) after 1 minute and then every 5 (ASPERITY_PROGRESS_EVERY=S: every S s;\n"
+       "progress=false: never); show(world) returns a string or a table of values to add to it;\n"
+       "fraction(world) returns the completion 0..1 for the percent and ETA when stop_when, not\n"
+       "steps, ends the run (with stop_when, steps is only a cap and gives neither).\n"
        "reason: \"steps\", \"equilibrium\" or \"stop_when\"."},
       {"dt", world_dt, "world:dt() -> s", "The time step in use."},
       {"set_dt", set_world_number<&World::set_dt>, "world:set_dt(dt)", "Fixes the time step (0: automatic again)."},
