@@ -68,6 +68,13 @@ bool Progress::due() {
 
 void Progress::draw(std::uint64_t done, const std::string& extra, double fraction) {
   const auto now = Clock::now();
+  const double since_last = std::chrono::duration<double>(now - last_).count();
+  const double instant = since_last > 0 ? double(done - last_done_) / since_last : 0;
+  rate_ = drawn_ ? 0.7 * rate_ + 0.3 * instant
+                 : double(done) / std::chrono::duration<double>(now - start_).count();
+  last_ = now;
+  last_done_ = done;
+  drawn_ = true;
   std::string line = text(done, extra, fraction, now);
   if (logging_) {
     std::fprintf(stderr, "%s\n", line.c_str());
@@ -81,15 +88,8 @@ void Progress::draw(std::uint64_t done, const std::string& extra, double fractio
   std::fflush(stderr);
 }
 
-std::string Progress::text(std::uint64_t done, const std::string& extra, double fraction, Clock::time_point now) {
-  double since_last = std::chrono::duration<double>(now - last_).count();
-  double instant = since_last > 0 ? double(done - last_done_) / since_last : 0;
-  rate_ = drawn_ ? 0.7 * rate_ + 0.3 * instant
-                 : double(done) / std::chrono::duration<double>(now - start_).count();
-  last_ = now;
-  last_done_ = done;
-  drawn_ = true;
-
+std::string Progress::text(std::uint64_t done, const std::string& extra, double fraction,
+                           Clock::time_point now) const {
   std::string line;
   char buf[96];
   double elapsed = std::chrono::duration<double>(now - start_).count();

@@ -37,7 +37,8 @@ class Progress {
 
  private:
   using Clock = std::chrono::steady_clock;
-  std::string text(std::uint64_t done, const std::string& extra, double fraction, Clock::time_point now);
+  // The line for `done` steps at `now` with the current rate (draw updates the rate first).
+  std::string text(std::uint64_t done, const std::string& extra, double fraction, Clock::time_point now) const;
   bool terminal_;  // redraw one line in place
   bool logging_;   // write a line now and then
   LogCadence log_;

@@ -153,7 +153,7 @@ function M.trends(rows, curves)
   -- On a joint of side L <= 2 Lc the spectrum's roll-off (chi = 1 / (2 Lc), surfaces.md 2) lies below
   -- its lowest frequency 1 / L: the surfaces that differ only in Lc are the same surface.
   local function unresolved_lc(r)
-    if r.verdict == "untestable" and r.comparisons > 0 then
+    if r.comparisons > 0 and r.ties == r.comparisons then
       r.reason = "the surfaces that differ only in Lc gave identical runs: on a joint of side L <= 2 Lc the " ..
                  "roll-off 1 / (2 Lc) lies below the lowest frequency 1 / L, so they are the same surface (the " ..
                  "study's Lc of 16 and 20 mm need joints over 4 cm)"
