@@ -117,6 +117,7 @@ struct StepContext {
 
   std::vector<double> pair_block_slip;
   std::vector<double> bond_block_breaks;
+  std::vector<double> bond_block_slip;
   std::vector<ParticleBlockResult> particle_blocks;
   // The group stages (bodies/groups.cpp): the members moved every step (busy members of lazy
   // groups, all members of the others) in slots by group (group g: moved_start[g] to
@@ -155,6 +156,9 @@ struct Caches {
   // stage that runs with spin): only spin makes them grow, so the bond stage may take the kernel
   // that neither carries nor stores them (kernels/bonds.cpp).
   bool bond_moments_zero = false;
+  // Some bond lost its beam or its contact bond (BondStore::holds): the bond kernel reads what
+  // holds; else every bond holds both and the column is not read. Set by refresh_bond_topology.
+  bool bonds_partial = false;
   // The layout of the bond records the last bond stage wrote (store/bonds.hpp): with the moment
   // (12 doubles a bond) or, by the kernel without moments, without (8). The gather reads them so.
   bool bond_records_with_moments = true;

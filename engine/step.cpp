@@ -20,6 +20,7 @@
 // The stages, in the order a step runs them:
 #include "neighbor/build.hpp"    // 1
 #include "kernels/pairs.hpp"     // 2
+#include "kernels/bond_law.hpp"
 #include "kernels/bonds.hpp"     // 3
 #include "kernels/walls.hpp"     // 4
 #include "kernels/integrate.hpp" // 5 + 7
@@ -319,14 +320,7 @@ Energies compute_energies(const State& s) {
   }
   const BondMaterial& bm = s.bonds.material;
   for_each_bond(s, [&](const BondStore& bq, std::size_t k) {  // a frozen bond keeps its energy
-    const double r2 = bq.beam_radius[k] * bq.beam_radius[k];
-    e.strain += bq.fn[k] * bq.fn[k] / (2 * m.kn) +
-                (bq.fsx[k] * bq.fsx[k] + bq.fsy[k] * bq.fsy[k] + bq.fsz[k] * bq.fsz[k]) / (2 * m.ks) +
-                bq.fbn[k] * bq.fbn[k] / (2 * bm.beam_kn) +
-                (bq.fbsx[k] * bq.fbsx[k] + bq.fbsy[k] * bq.fbsy[k] + bq.fbsz[k] * bq.fbsz[k]) / (2 * bm.beam_ks) +
-                bq.mbn[k] * bq.mbn[k] / (2 * bm.beam_ks * 0.5 * r2) +
-                (bq.mbsx[k] * bq.mbsx[k] + bq.mbsy[k] * bq.mbsy[k] + bq.mbsz[k] * bq.mbsz[k]) /
-                    (2 * bm.beam_kn * 0.25 * r2);
+    e.strain += kernels::spring_energy(bq, k, m) + kernels::beam_energy(bq, k, bm);
   });
   e.released = s.ledger.released;
   e.friction = s.ledger.friction;

@@ -661,16 +661,22 @@ std::size_t World::install_bonds(const BondMaterial& material, double tolerance,
   return installed;
 }
 
-std::size_t World::bond_count() const { return state_->bonds.n + state_->frozen_bonds.n; }
+std::size_t World::bond_count() const {
+  std::size_t n = 0;  // the parallel bonds that hold (a pair held by its contact bond alone is not one)
+  detail::for_each_bond(*state_, [&](const detail::BondStore& q, std::size_t k) { n += q.holds[k] != detail::kContactBondHolds; });
+  return n;
+}
 
-void World::set_bond_strength(double tensile_strength, bool breakable) {
+void World::set_bond_strength(double tensile_strength, bool breakable, std::optional<double> contact_strength) {
   require(!breakable || (tensile_strength > 0 && std::isfinite(tensile_strength)),
           "set_bond_strength: a breakable bond needs tensile_strength > 0 (Pa), got " +
               num(tensile_strength));
-  for (detail::BondStore* q : {&state_->bonds, &state_->frozen_bonds}) {
-    q->material.tensile_strength = breakable ? tensile_strength : 0.0;
-    q->material.breakable = breakable;
-  }
+  BondMaterial m = state_->bonds.material;
+  m.tensile_strength = breakable ? tensile_strength : 0.0;
+  m.breakable = breakable;
+  if (contact_strength) m.contact_strength = *contact_strength;
+  check_value("set_bond_strength: ", Field{"bond material"}, m);
+  for (detail::BondStore* q : {&state_->bonds, &state_->frozen_bonds}) q->material = m;
 }
 
 void World::remove_bonds() {
@@ -700,10 +706,9 @@ std::vector<BondInfo> World::bonds() const {
     b.shear_force = {q.fsx[k] + q.fbsx[k], q.fsy[k] + q.fbsy[k], q.fsz[k] + q.fbsz[k]};
     b.twisting_moment = q.mbn[k];
     b.bending_moment = {q.mbsx[k], q.mbsy[k], q.mbsz[k]};
-    const double rb = q.beam_radius[k], A = kernels::kPi * rb * rb;
-    const Vec3 fbs{q.fbsx[k], q.fbsy[k], q.fbsz[k]};
-    b.sigma = -q.fbn[k] / A + norm(b.bending_moment) * 4.0 / (A * rb);  // [3-27]
-    b.tau = norm(fbs) / A + std::fabs(q.mbn[k]) * 2.0 / (A * rb);
+    kernels::beam_stresses(q, k, b.sigma, b.tau);
+    b.beam = q.holds[k] != detail::kContactBondHolds;
+    b.contact_bond = q.holds[k] != detail::kBeamHolds;
     if (b.id_a > b.id_b) {
       std::swap(b.id_a, b.id_b);
       b.normal = -b.normal;

@@ -96,7 +96,7 @@ void bm_neighbors(benchmark::State& st, int edge, int threads) {
 template <class Kernel, class Args>
 void time_blocks(benchmark::State& st, int threads, Kernel kernel, const Args& k, std::size_t total) {
   const std::size_t blocks = (total + kPairBlock - 1) / kPairBlock;
-  std::vector<double> out(blocks);
+  std::vector<decltype(kernel(k, 0, 0))> out(blocks);
   for (auto _ : st) {
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (std::size_t blk = 0; blk < blocks; ++blk) {

@@ -29,13 +29,15 @@ namespace asperity {
 namespace {
 
 using detail::State;
-constexpr int kCheckpointVersion = 8;  // 2: servo integral and integral time, group damping;
+constexpr int kCheckpointVersion = 9;  // 2: servo integral and integral time, group damping;
                                        // 3: rest overlaps (stress-free bonds);
                                        // 4: meshes' candidates within half the skin;
                                        // 5: a header with a checksum in the HDF5 user block;
                                        // 6: rotation_lock_bonds;
                                        // 7: bonds broken per particle;
-                                       // 8: overlap_limit
+                                       // 8: overlap_limit;
+                                       // 9: contact bonds apart from the beam (what holds,
+                                       //    contact_strength, the kind of a break)
 
 // The file's kind in the header of its HDF5 user block (io::h5::file_image), whose checksum is
 // verified before HDF5 parses the file: HDF5 does not survive every corruption of its metadata.
@@ -254,7 +256,7 @@ void visit(Io& io, State& s) {
     std::vector<std::uint64_t> step(ev.size());
     std::vector<double> num(ev.size() * 7);
     std::vector<std::int64_t> ids(ev.size() * 2);
-    std::vector<std::uint8_t> mode(ev.size());
+    std::vector<std::uint8_t> mode(ev.size()), kind(ev.size());
     for (std::size_t k = 0; k < ev.size(); ++k) {
       step[k] = ev[k].step;
       const double v[7] = {ev[k].time, ev[k].position.x, ev[k].position.y, ev[k].position.z,
@@ -263,11 +265,13 @@ void visit(Io& io, State& s) {
       ids[2 * k] = ev[k].id_a;
       ids[2 * k + 1] = ev[k].id_b;
       mode[k] = static_cast<std::uint8_t>(ev[k].mode);
+      kind[k] = static_cast<std::uint8_t>(ev[k].kind);
     }
     io.column("breaks/step", step);
     io.column("breaks/values", num);
     io.column("breaks/ids", ids);
     io.column("breaks/mode", mode);
+    if (io.version >= 9) io.column("breaks/kind", kind);  // older files: beams only
     for (std::size_t k = 0; k < ev.size(); ++k) {  // reader: put them back
       ev[k].step = step[k];
       ev[k].time = num[7 * k];
@@ -278,6 +282,7 @@ void visit(Io& io, State& s) {
       ev[k].id_a = ids[2 * k];
       ev[k].id_b = ids[2 * k + 1];
       ev[k].mode = static_cast<BreakEvent::Mode>(mode[k]);
+      ev[k].kind = static_cast<BreakEvent::Kind>(kind[k]);
     }
   }
 
@@ -447,10 +452,13 @@ void validate(const State& s, const std::string& path) {
   const auto& b = s.bonds;
   pair_like(b, "bonds", bond_columns);
   for (std::size_t k = 0; k < b.n; ++k) need(b.beam_radius[k] >= 0, "bonds/beam_radius");
+  for (std::size_t k = 0; k < b.n; ++k)
+    need(b.holds[k] == detail::kBeamHolds || b.holds[k] == detail::kContactBondHolds || b.holds[k] == detail::kBothHold,
+         "bonds/holds");
   need(setting_valid(Field{"material"}, b.material), "bonds/material");
   for (const BreakEvent& e : s.break_events)
     need(e.id_a >= 0 && e.id_b >= 0 && e.id_a < std::int64_t(n) && e.id_b < std::int64_t(n) &&
-             std::uint8_t(e.mode) <= 2,
+             std::uint8_t(e.mode) <= 2 && std::uint8_t(e.kind) <= 1,
          "breaks");
 
   // Walls and meshes.

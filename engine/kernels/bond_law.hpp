@@ -12,6 +12,10 @@
 // Elliptic criterion: ((sigma - h) / a)^2 + (tau / b)^2 >= 1, a = 5.5 st, h = -4.5 st,
 // b = 5 st a / sqrt(a^2 - h^2): fails at sigma = st, sigma = -10 st, tau = 5 st.
 #pragma once
+#include <cmath>
+#include <cstddef>
+
+#include "asperity/materials.hpp"
 #include "kernels/contact_law.hpp"
 
 namespace asperity::kernels {
@@ -22,7 +26,18 @@ template <class T>
 struct BondParams {
   T kn, ks, beam_kn, beam_ks, dt;
   T strength;   // st; 0 or less: unbreakable
+  T friction;   // of the contact springs once their contact bond broke
 };
+
+// The contact bond's failure (model.md 5, PFC's contact bond): its tensile normal force (fn < 0)
+// or its shear force reaches Fc = c st A. Compression never breaks it. Per lane: 0 where it
+// holds, else 1 where the tension reached Fc, 2 where only the shear did.
+template <class T>
+inline T contact_bond_failure(const T& fn, const T& fsx, const T& fsy, const T& fsz, const T& fc) {
+  const auto tension = fn <= -fc;
+  const auto shear = fsx * fsx + fsy * fsy + fsz * fsz >= fc * fc;
+  return select(tension, T(1.0), select(shear, T(2.0), T(0.0)));
+}
 
 // Criterion value ((sigma - h) / a)^2 + (tau / b)^2 for strength st (>= 1: the bond fails).
 template <class T>
@@ -105,6 +120,36 @@ inline T bond_forces(const T& nx, const T& ny, const T& nz, const T& U, const T&
     tau = fbs / A + T(0.0);
   }
   return elliptic_criterion(sigma, tau, p.strength);
+}
+
+// --- one stored bond k of a bond store (store/bonds.hpp), read in double precision: what the
+// break processing, the step's energy and the world's queries all take from here -------------
+
+// Periphery stresses of the beam [3-27], tension positive.
+template <class Store>
+inline void beam_stresses(const Store& q, std::size_t k, double& sigma, double& tau) {
+  const double rb = q.beam_radius[k], A = kPi * rb * rb;
+  const double fbs = std::sqrt(q.fbsx[k] * q.fbsx[k] + q.fbsy[k] * q.fbsy[k] + q.fbsz[k] * q.fbsz[k]);
+  const double mbs = std::sqrt(q.mbsx[k] * q.mbsx[k] + q.mbsy[k] * q.mbsy[k] + q.mbsz[k] * q.mbsz[k]);
+  sigma = -q.fbn[k] / A + mbs * 4.0 / (A * rb);
+  tau = fbs / A + std::fabs(q.mbn[k]) * 2.0 / (A * rb);
+}
+
+// Strain energy of the beam (model.md 8): Fbn^2/(2 kbn A) + |Fbs|^2/(2 kbs A) + Mbn^2/(2 kbs J)
+// + |Mbs|^2/(2 kbn I), with kbs J = beam_ks Rb^2 / 2 and kbn I = beam_kn Rb^2 / 4.
+template <class Store>
+inline double beam_energy(const Store& q, std::size_t k, const BondMaterial& bm) {
+  const double r2 = q.beam_radius[k] * q.beam_radius[k];
+  return q.fbn[k] * q.fbn[k] / (2 * bm.beam_kn) +
+         (q.fbsx[k] * q.fbsx[k] + q.fbsy[k] * q.fbsy[k] + q.fbsz[k] * q.fbsz[k]) / (2 * bm.beam_ks) +
+         q.mbn[k] * q.mbn[k] / (2 * bm.beam_ks * 0.5 * r2) +
+         (q.mbsx[k] * q.mbsx[k] + q.mbsy[k] * q.mbsy[k] + q.mbsz[k] * q.mbsz[k]) / (2 * bm.beam_kn * 0.25 * r2);
+}
+
+// Strain energy of the contact springs (model.md 8): Fn^2/(2 kn) + |Fs|^2/(2 ks).
+template <class Store>
+inline double spring_energy(const Store& q, std::size_t k, const ContactMaterial& m) {
+  return q.fn[k] * q.fn[k] / (2 * m.kn) + (q.fsx[k] * q.fsx[k] + q.fsy[k] * q.fsy[k] + q.fsz[k] * q.fsz[k]) / (2 * m.ks);
 }
 
 }  // namespace asperity::kernels

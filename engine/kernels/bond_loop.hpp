@@ -1,5 +1,7 @@
 // The bond loop shared by the scalar reference and the SIMD kernels (see pair_loop.hpp).
 #pragma once
+#include <limits>
+
 #include "kernels/a_side.hpp"
 #include "kernels/bond_law.hpp"
 #include "kernels/kernels.hpp"
@@ -10,11 +12,15 @@ namespace asperity::kernels {
 // columns are neither read nor written, and the record is the first eight values only (its
 // moment would be +-0), eight doubles a bond.
 template <class Lanes, bool Rotation, bool Moments = true>
-double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
+BondSums bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
   using T = typename Lanes::Real;
-  const BondParams<T> p{T(k.kn), T(k.ks), T(k.beam_kn), T(k.beam_ks), T(k.dt), T(k.strength)};
+  const BondParams<T> p{T(k.kn), T(k.ks), T(k.beam_kn), T(k.beam_ks), T(k.dt), T(k.strength), T(k.friction)};
+  const LawParams<T> contact{T(k.kn), T(k.ks), T(k.friction), T(k.dt)};
   const bool breakable = k.strength > 0;
-  T count(0.0);
+  // The contact bond breaks with the beam (c = 0), never (c = inf) or at c st A (model.md 5).
+  const bool with_beam = k.contact_strength == 0;
+  const bool contact_breaks = !with_beam && k.contact_strength < std::numeric_limits<double>::infinity();
+  T count(0.0), slip(0.0);
   for (std::size_t i = begin; i < end; i += Lanes::size) {
     const BatchSides<T> q = load_sides<Lanes, Rotation>(k, i);
     T nx, ny, nz, U, la, lb;
@@ -36,12 +42,48 @@ double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
     const T crit = bond_forces<T, Rotation, Moments>(nx, ny, nz, U, la, lb, rsafe, q.vax, q.vay, q.vaz,
                                             q.wax, q.way, q.waz, q.vbx, q.vby, q.vbz, q.wbx, q.wby,
                                             q.wbz, ox, oy, oz, u0, s, sigma, tau, p);
+    // A bond that lost a part (BondStore::holds): without its beam the beam's force and moments
+    // stay 0 and it cannot break again; without its contact bond the contact springs follow the
+    // ordinary contact law (the shear force was carried and incremented above as any contact's).
+    auto beam_on = real, contact_on = real;
+    if (k.holds != nullptr) {
+      const T hold = Lanes::load(k.holds + i);
+      beam_on = real & ((hold == T(kBeamHolds)) | (hold == T(kBothHold)));
+      contact_on = real & (hold >= T(kContactBondHolds));
+      s.fbn = select(beam_on, s.fbn, T(0.0));
+      s.fbsx = select(beam_on, s.fbsx, T(0.0));
+      s.fbsy = select(beam_on, s.fbsy, T(0.0));
+      s.fbsz = select(beam_on, s.fbsz, T(0.0));
+      if constexpr (Moments) {
+        s.mbn = select(beam_on, s.mbn, T(0.0));
+        s.mbsx = select(beam_on, s.mbsx, T(0.0));
+        s.mbsy = select(beam_on, s.mbsy, T(0.0));
+        s.mbsz = select(beam_on, s.mbsz, T(0.0));
+      }
+      const auto ordinary = real & !contact_on;
+      if (any(ordinary)) {
+        T fx = s.fsx, fy = s.fsy, fz = s.fsz, fn;
+        // A stress-free bond's contact keeps its rest overlap, a gap bond's (rest < 0) none.
+        const T e = contact_cap(U, select(u0 > T(0.0), u0, T(0.0)), fx, fy, fz, fn, contact);
+        slip = slip + select(ordinary, e, T(0.0));
+        s.fsx = select(ordinary, fx, s.fsx);
+        s.fsy = select(ordinary, fy, s.fsy);
+        s.fsz = select(ordinary, fz, s.fsz);
+        s.fn = select(ordinary, fn, s.fn);
+      }
+    }
     if (breakable) {
-      // The flags stay 0 but where a bond breaks (process_breaks removes those; bond_stage clears
+      // The flags stay 0 but where a bond breaks (process_breaks handles those; bond_stage clears
       // the column after a step whose breaks were not processed), so only such a batch stores:
       // no column written at every step for nothing.
-      const T brk = select(real & (crit >= T(1.0)), T(1.0), T(0.0));
-      count = count + brk;
+      const auto beam_fails = beam_on & (crit >= T(1.0));
+      T brk = select(beam_fails, T(with_beam ? kBothHold : kBeamHolds), T(0.0));
+      if (contact_breaks) {
+        const T fc = T(k.contact_strength) * p.strength * (kPi * rsafe * rsafe);  // c st A
+        const T cf = contact_bond_failure(s.fn, s.fsx, s.fsy, s.fsz, fc);
+        brk = brk + select(contact_on & (cf != T(0.0)), T(kContactBondHolds), T(0.0));
+      }
+      count = count + select(brk != T(0.0), T(1.0), T(0.0));
       if (any(brk != T(0.0))) Lanes::store(k.broken + i, brk);
     }
     Lanes::store(k.nx + i, nx); Lanes::store(k.ny + i, ny); Lanes::store(k.nz + i, nz);
@@ -66,7 +108,7 @@ double bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
                           s.mbn * nx + s.mbsx, s.mbn * ny + s.mbsy, s.mbn * nz + s.mbsz, T(0.0)};
     Lanes::template store_records<width>(k.out + width * i, record);
   }
-  return Lanes::sum(count);
+  return {Lanes::sum(count), Lanes::sum(slip)};
 }
 
 }  // namespace asperity::kernels

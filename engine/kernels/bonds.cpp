@@ -23,35 +23,24 @@ kernels::BondKernelArgs bond_kernel_args(State& s) {
           q.fbsy.data(), q.fbsz.data(), q.mbn.data(), q.mbsx.data(), q.mbsy.data(),
           q.mbsz.data(), q.broken.data(), q.out.data(), m.kn, m.ks,
           bm.beam_kn, bm.beam_ks, s.dt, bm.breakable ? bm.tensile_strength : 0.0, p.capacity,
-          s.rest_overlaps ? q.rest.data() : nullptr};
+          s.rest_overlaps ? q.rest.data() : nullptr, s.cache.bonds_partial ? q.holds.data() : nullptr,
+          m.friction, bm.contact_strength};
 }
 
 namespace {
-struct BondEnergy {
-  double total, contact_kept, capped_fs_scale;
-};
-
-// Strain energy of bond k (model.md 8) and what an ordinary contact keeps of it after a break.
-BondEnergy bond_energy(const State& s, std::size_t k) {
-  const BondStore& q = s.bonds;
-  const ContactMaterial& m = s.settings.contact;
-  const BondMaterial& bm = q.material;
-  const double r2 = q.beam_radius[k] * q.beam_radius[k];
+// The contact springs of bond k as an ordinary contact (model.md 4) from now on: Fn = kn (U - rest)
+// >= 0 and Fs capped at mu Fn while the pair touches, nothing once it does not. Returns the
+// strain energy they keep and gives the factor of the cap on Fs (0 once apart).
+double kept_as_contact(const BondStore& q, std::size_t k, const ContactMaterial& m, double& fn,
+                       double& fs_scale) {
+  fn = 0;
+  fs_scale = 0;
+  if (!(q.overlap[k] > 0)) return 0;
+  fn = std::max(q.fn[k], 0.0);
   const double fs2 = q.fsx[k] * q.fsx[k] + q.fsy[k] * q.fsy[k] + q.fsz[k] * q.fsz[k];
-  const double fbs2 = q.fbsx[k] * q.fbsx[k] + q.fbsy[k] * q.fbsy[k] + q.fbsz[k] * q.fbsz[k];
-  const double mbs2 = q.mbsx[k] * q.mbsx[k] + q.mbsy[k] * q.mbsy[k] + q.mbsz[k] * q.mbsz[k];
-  BondEnergy e;
-  e.total = q.fn[k] * q.fn[k] / (2 * m.kn) + fs2 / (2 * m.ks) + q.fbn[k] * q.fbn[k] / (2 * bm.beam_kn) +
-            fbs2 / (2 * bm.beam_ks) + q.mbn[k] * q.mbn[k] / (2 * bm.beam_ks * 0.5 * r2) +
-            mbs2 / (2 * bm.beam_kn * 0.25 * r2);
-  e.contact_kept = 0;
-  e.capped_fs_scale = 0;
-  if (q.overlap[k] > 0) {  // stays a contact: Fn = kn (U - rest) >= 0, Fs capped at mu Fn
-    const double fn = std::max(q.fn[k], 0.0), limit = m.friction * fn, fs = std::sqrt(fs2);
-    e.capped_fs_scale = fs > limit ? limit / fs : 1.0;
-    e.contact_kept = fn * fn / (2 * m.kn) + fs2 * e.capped_fs_scale * e.capped_fs_scale / (2 * m.ks);
-  }
-  return e;
+  const double limit = m.friction * fn, fs = std::sqrt(fs2);
+  fs_scale = fs > limit ? limit / fs : 1.0;
+  return fn * fn / (2 * m.kn) + fs2 * fs_scale * fs_scale / (2 * m.ks);
 }
 }  // namespace
 
@@ -83,6 +72,9 @@ void refresh_bond_topology(State& s) {
   s.cache.bonded_particles.clear();  // what the bond stage reads: the ends of the bonds it computes
   for (std::size_t i = 0; i < p.n; ++i)
     if (s.cache.bond_incidence.start[i + 1] > s.cache.bond_incidence.start[i]) s.cache.bonded_particles.push_back(std::int32_t(i));
+  // Some bond lost a part: the kernel reads what holds (BondStore::holds).
+  s.cache.bonds_partial = false;
+  for (std::size_t k = 0; k < q.n && !s.cache.bonds_partial; ++k) s.cache.bonds_partial = q.holds[k] != kBothHold;
   // Beam moments: new bonds start without one, and a checkpoint or a break may bring back some.
   s.cache.bond_moments_zero = true;
   for (std::size_t k = 0; k < q.n && s.cache.bond_moments_zero; ++k)
@@ -205,12 +197,23 @@ StageLoop bond_stage(State& s) {
       break;
     }
   s.ctx.bond_block_breaks.assign(st.blocks, 0.0);
+  s.ctx.bond_block_slip.assign(st.blocks, 0.0);
   double* breaks = s.ctx.bond_block_breaks.data();
+  double* slip = s.ctx.bond_block_slip.data();
   st.run = [=](std::size_t blk) {
     const std::size_t begin = blk * block;
-    breaks[blk] = kernel(args, begin, std::min(total, begin + block));
+    const kernels::BondSums sums = kernel(args, begin, std::min(total, begin + block));
+    breaks[blk] = sums.breaks;
+    slip[blk] = sums.slip;
   };
-  return st;  // no finish: the breaks are processed after the step (process_breaks)
+  // The breaks are processed after the step (process_breaks); the slip of contact springs whose
+  // contact bond broke is booked here, in block order.
+  if (args.holds != nullptr)
+    st.finish = [&s, slip, blocks = st.blocks] {
+      if (s.settings.track_energy)
+        for (std::size_t blk = 0; blk < blocks; ++blk) s.ledger.friction += slip[blk];
+    };
+  return st;
 }
 
 void process_breaks(State& s) {
@@ -224,44 +227,77 @@ void process_breaks(State& s) {
   // written), so a break step allocates no new store: at thesis scale the bond list is tens of MB,
   // and fresh pages for it on every break step cost as much as the bond stage.
   std::size_t kept = 0;
-  // The freed pairs, in bond order (sorted by (a, b) like the bond list they come from), made
-  // while the bond's slot is still intact. A touching one keeps the contact bond's normal and
-  // shear force capped at the friction limit; the others start as the search starts a new pair
-  // (no shear force, the current direction as the previous normal).
+  // The freed pairs (bonds of which nothing holds any more), in bond order (sorted by (a, b) like
+  // the bond list they come from), made while the bond's slot is still intact. A touching one
+  // keeps the contact's normal and shear force capped at the friction limit; the others start as
+  // the search starts a new pair (no shear force, the current direction as the previous normal).
   PairStore freed;
   std::size_t nfreed = 0;
+  const ContactMaterial& m = s.settings.contact;
+  const BondMaterial& bm = q.material;
+  const bool with_beam = bm.contact_strength == 0;
   for (std::size_t k = 0; k < q.n; ++k) {
     if (q.broken[k] == 0) {
       if (kept != k) q.copy_from(q, k, kept);
       ++kept;
       continue;
     }
+    const auto parts = static_cast<int>(q.broken[k]);
+    const int holds = static_cast<int>(q.holds[k]) & ~parts;
     const auto a = q.a[k], b = q.b[k];
-    const double rb = q.beam_radius[k], A = kernels::kPi * rb * rb;
-    const double fbs = std::sqrt(q.fbsx[k] * q.fbsx[k] + q.fbsy[k] * q.fbsy[k] + q.fbsz[k] * q.fbsz[k]);
-    const double mbs = std::sqrt(q.mbsx[k] * q.mbsx[k] + q.mbsy[k] * q.mbsy[k] + q.mbsz[k] * q.mbsz[k]);
-    const double sigma = -q.fbn[k] / A + mbs * 4.0 / (A * rb);
-    const double tau = fbs / A + std::fabs(q.mbn[k]) * 2.0 / (A * rb);
-    // Mode: the stress closest (relative to its own failure value: st in tension, 10 st in
-    // compression, 5 st in shear) to failing on its own dominates.
-    const double st = q.material.tensile_strength;
-    const double normal_part = sigma >= 0 ? sigma / st : -sigma / (10 * st);
-    const double shear_part = tau / (5 * st);
+    const Vec3 n{q.nx[k], q.ny[k], q.nz[k]};
     BreakEvent ev;
     ev.step = s.step;
     ev.time = s.time;
-    const Vec3 n{q.nx[k], q.ny[k], q.nz[k]};
     ev.position = Vec3{p.x[a], p.y[a], p.z[a]} + n * (p.radius[a] - 0.5 * q.overlap[k]);
     ev.id_a = p.id[a];
     ev.id_b = p.id[b];
-    ev.mode = shear_part > normal_part ? BreakEvent::Mode::shear
-              : (sigma >= 0 ? BreakEvent::Mode::tension : BreakEvent::Mode::compression);
-    ev.sigma = sigma;
-    ev.tau = tau;
-    const BondEnergy e = bond_energy(s, k);
-    ev.released_energy = e.total - e.contact_kept;
-    if (s.settings.track_energy) s.ledger.released += ev.released_energy;
-    s.break_events.push_back(ev);
+    auto book = [&](double released) {
+      ev.released_energy = released;
+      if (s.settings.track_energy) s.ledger.released += released;
+      s.break_events.push_back(ev);
+    };
+    // What the contact springs keep when the contact bond goes: an ordinary contact's forces.
+    double fn_kept = 0, fs_scale = 0, spring_kept = 0;
+    const bool contact_goes = (parts & int(kContactBondHolds)) != 0;
+    if (contact_goes) spring_kept = kept_as_contact(q, k, m, fn_kept, fs_scale);
+    if (parts & int(kBeamHolds)) {
+      // Mode: the stress closest (relative to its own failure value: st in tension, 10 st in
+      // compression, 5 st in shear) to failing on its own dominates.
+      kernels::beam_stresses(q, k, ev.sigma, ev.tau);
+      const double st = bm.tensile_strength;
+      const double normal_part = ev.sigma >= 0 ? ev.sigma / st : -ev.sigma / (10 * st);
+      const double shear_part = ev.tau / (5 * st);
+      ev.mode = shear_part > normal_part ? BreakEvent::Mode::shear
+                : (ev.sigma >= 0 ? BreakEvent::Mode::tension : BreakEvent::Mode::compression);
+      ev.kind = BreakEvent::Kind::beam;
+      // Breaking with the beam, the contact bond's lost energy is the beam event's too.
+      const double contact_part = with_beam ? kernels::spring_energy(q, k, m) - spring_kept : 0.0;
+      book(kernels::beam_energy(q, k, bm) + contact_part);
+      q.fbn[k] = q.fbsx[k] = q.fbsy[k] = q.fbsz[k] = 0;
+      q.mbn[k] = q.mbsx[k] = q.mbsy[k] = q.mbsz[k] = 0;
+    }
+    if (contact_goes && !with_beam) {
+      const double rb = q.beam_radius[k], A = kernels::kPi * rb * rb;
+      const double fs = std::sqrt(q.fsx[k] * q.fsx[k] + q.fsy[k] * q.fsy[k] + q.fsz[k] * q.fsz[k]);
+      ev.sigma = -q.fn[k] / A;
+      ev.tau = fs / A;
+      ev.mode = -q.fn[k] >= bm.contact_strength * bm.tensile_strength * A ? BreakEvent::Mode::tension
+                                                                          : BreakEvent::Mode::shear;
+      ev.kind = BreakEvent::Kind::contact_bond;
+      book(kernels::spring_energy(q, k, m) - spring_kept);
+    }
+    if (contact_goes) {  // the springs become an ordinary contact's (the kernel's law from now on)
+      q.fn[k] = fn_kept;
+      q.fsx[k] *= fs_scale; q.fsy[k] *= fs_scale; q.fsz[k] *= fs_scale;
+    }
+    q.broken[k] = 0;
+    if (holds != 0) {  // the other part holds: the bond stays, with what is left of it
+      q.holds[k] = holds;
+      if (kept != k) q.copy_from(q, k, kept);
+      ++kept;
+      continue;
+    }
     ++s.p.bonds_broken[a];
     ++s.p.bonds_broken[b];
     // The pair enters the contact list now (the search never listed it while it was bonded),
@@ -273,10 +309,11 @@ void process_breaks(State& s) {
     freed.a[t] = q.a[k]; freed.b[t] = q.b[k];
     freed.overlap[t] = q.overlap[k];
     if (q.overlap[k] > 0) {
-      const double scale = bond_energy(s, k).capped_fs_scale;
+      // Keeps the contact's normal and shear force (capped at the friction limit above, or as
+      // the ordinary contact law left them).
       freed.nx[t] = q.nx[k]; freed.ny[t] = q.ny[k]; freed.nz[t] = q.nz[k];
-      freed.fsx[t] = q.fsx[k] * scale; freed.fsy[t] = q.fsy[k] * scale; freed.fsz[t] = q.fsz[k] * scale;
-      freed.fn[t] = std::max(q.fn[k], 0.0);  // a contact bond held in tension leaves no force
+      freed.fsx[t] = q.fsx[k]; freed.fsy[t] = q.fsy[k]; freed.fsz[t] = q.fsz[k];
+      freed.fn[t] = q.fn[k];
       // A stress-free bond's contact stays unloaded at its rest overlap; a gap bond's (rest < 0)
       // becomes an ordinary contact, which never pulls.
       freed.rest[t] = std::max(q.rest[k], 0.0);
@@ -338,6 +375,7 @@ std::size_t install_bonds(State& s, const BondMaterial& material, double toleran
     fresh.fn[k] = s.settings.contact.kn * (fresh.overlap[k] - fresh.rest[k]);
     fresh.fbn[k] = fresh.fbsx[k] = fresh.fbsy[k] = fresh.fbsz[k] = 0;
     fresh.mbn[k] = fresh.mbsx[k] = fresh.mbsy[k] = fresh.mbsz[k] = fresh.broken[k] = 0;
+    fresh.holds[k] = kBothHold;
   }
   s.bonds = merge_bonds(s.bonds, fresh);
   s.bonds.material = material;

@@ -90,22 +90,14 @@ inline void contact_kinematics(const T& nx, const T& ny, const T& nz, const T& l
   vsz = vz - vn * nz;
 }
 
-// Forces of one contact from its geometry (normal n, overlap U) and kinematics (Vs, phi:
-// contact_kinematics), with rest overlap U0 (the overlap of the unloaded spring: 0 in model.md 4;
-// > 0 for a contact left by a bond installed stress-free). On entry (o, F) hold the normal and
-// shear force of the previous step; on exit F is the new shear force on b and fn the normal
-// force on b. Returns the energy dissipated by slip in this step.
-template <class T, bool Spin = true>
-inline T contact_response(const T& nx, const T& ny, const T& nz, const T& U, const T& vsx,
-                          const T& vsy, const T& vsz, const T& phi, const T& ox, const T& oy,
-                          const T& oz, const T& U0, T& fx, T& fy, T& fz, T& fn,
-                          const LawParams<T>& p) {
+// The ordinary contact's normal force, slip and loss of contact [3-12, 3-22, model.md 4], from
+// the overlap U, the rest overlap U0 (the overlap of the unloaded spring: 0 in model.md 4; > 0
+// for a contact left by a bond installed stress-free) and the trial shear force F (the carried
+// history plus this step's increment), which it caps. Gives the normal force fn on b; returns
+// the energy dissipated by slip. Also the contact springs of a bond whose contact bond broke.
+template <class T>
+inline T contact_cap(const T& U, const T& U0, T& fx, T& fy, T& fz, T& fn, const LawParams<T>& p) {
   const auto touching = U > T(0.0);
-  carry_shear<T, Spin>(ox, oy, oz, nx, ny, nz, phi, fx, fy, fz);
-  // Incremental shear force [3-19..3-21]: dFs = -ks Vs dt.
-  fx = fx - p.ks * vsx * p.dt;
-  fy = fy - p.ks * vsy * p.dt;
-  fz = fz - p.ks * vsz * p.dt;
   // Normal force [3-12], no tension. With U0 = 0 this is kn U wherever U > 0, bit for bit; a
   // touching pair with 0 < U <= U0 carries no force (and so, by the slip cap, no shear force).
   fn = select(U > U0, p.kn * (U - U0), T(0.0));
@@ -127,6 +119,23 @@ inline T contact_response(const T& nx, const T& ny, const T& nz, const T& U, con
   fy = select(touching, fy * scale, T(0.0));
   fz = select(touching, fz * scale, T(0.0));
   return slip_energy;
+}
+
+// Forces of one contact from its geometry (normal n, overlap U) and kinematics (Vs, phi:
+// contact_kinematics), with rest overlap U0 (contact_cap). On entry (o, F) hold the normal and
+// shear force of the previous step; on exit F is the new shear force on b and fn the normal
+// force on b. Returns the energy dissipated by slip in this step.
+template <class T, bool Spin = true>
+inline T contact_response(const T& nx, const T& ny, const T& nz, const T& U, const T& vsx,
+                          const T& vsy, const T& vsz, const T& phi, const T& ox, const T& oy,
+                          const T& oz, const T& U0, T& fx, T& fy, T& fz, T& fn,
+                          const LawParams<T>& p) {
+  carry_shear<T, Spin>(ox, oy, oz, nx, ny, nz, phi, fx, fy, fz);
+  // Incremental shear force [3-19..3-21]: dFs = -ks Vs dt.
+  fx = fx - p.ks * vsx * p.dt;
+  fy = fy - p.ks * vsy * p.dt;
+  fz = fz - p.ks * vsz * p.dt;
+  return contact_cap(U, U0, fx, fy, fz, fn, p);
 }
 
 // Both in one: the contact law of model.md 4 for a contact whose geometry is known (normal n,

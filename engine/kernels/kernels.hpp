@@ -49,9 +49,15 @@ struct PairKernelArgs {
 
 using PairKernel = double (*)(const PairKernelArgs&, std::size_t begin, std::size_t end);
 
-// Bond kernel: bonds [begin, end) of the bond list; sets broken[k] = 1 where the elliptic
-// criterion is met (only when strength > 0) and leaves the other flags as they are (all 0 between
-// steps: BondStore::broken). Returns the number of bonds broken.
+// What of a bond still holds (BondStore::holds, a bit set; model.md 5): the parallel bond (beam)
+// and the contact bond break separately; an entry with neither leaves the bond list.
+inline constexpr double kBeamHolds = 1, kContactBondHolds = 2, kBothHold = 3;
+
+// Bond kernel: bonds [begin, end) of the bond list; where a part breaks (only when strength > 0)
+// sets broken[k] to the parts that broke (kBeamHolds: the beam by the elliptic criterion,
+// kContactBondHolds: the contact bond; store/bonds.hpp) and leaves the other flags as they are
+// (all 0 between steps: BondStore::broken). Returns the number of bonds with a break and the
+// slip energy of the contact springs whose contact bond broke.
 struct BondKernelArgs {
   const double* x; const double* y; const double* z;
   const double* vx; const double* vy; const double* vz;
@@ -71,9 +77,20 @@ struct BondKernelArgs {
   double kn, ks, beam_kn, beam_ks, dt, strength;
   std::size_t columns = 0;  // as PairKernelArgs::columns
   const double* rest = nullptr;  // rest overlaps of the contact bonds; null: all 0
+  // What of each bond holds (BondStore::holds); null: every bond holds both parts.
+  const double* holds = nullptr;
+  double friction = 0;  // of the contact springs whose contact bond broke
+  // c of the contact bond's strength c st A (BondMaterial::contact_strength): 0 breaks it with
+  // the beam, inf never.
+  double contact_strength = 0;
 };
 
-using BondKernel = double (*)(const BondKernelArgs&, std::size_t begin, std::size_t end);
+struct BondSums {
+  double breaks = 0;  // bonds of which a part broke
+  double slip = 0;    // J, Coulomb slip of contact springs without their contact bond
+};
+
+using BondKernel = BondSums (*)(const BondKernelArgs&, std::size_t begin, std::size_t end);
 
 // Plane wall kernel (wall_loop.hpp): ball-plane contacts [begin, end) of the wall contact list,
 // all of them with planes; the plane is body a of the contact law (model.md 4), translating with

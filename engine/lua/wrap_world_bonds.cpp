@@ -23,6 +23,10 @@ const char* break_mode_name(BreakEvent::Mode m) {
   return "?";
 }
 
+const char* break_kind_name(BreakEvent::Kind k) {
+  return k == BreakEvent::Kind::beam ? "beam" : "contact_bond";
+}
+
 int world_install_bonds(lua_State* L) {
   return guarded(L, [&] {
     World& w = world_arg(L);
@@ -65,10 +69,11 @@ int world_set_bond_strength(lua_State* L) {
     Options o(L, 2, "world:set_bond_strength", 2);
     const bool breakable = o.boolean("breakable", true);
     const auto st = o.number("tensile_strength");
+    const auto c = o.number("contact_strength");
     o.finish();
     if (breakable && !st)
       throw Error("world:set_bond_strength: give tensile_strength = (Pa), or breakable = false");
-    w.set_bond_strength(st ? *st : 0.0, breakable);
+    w.set_bond_strength(st ? *st : 0.0, breakable, c);
     return 0;
   });
 }
@@ -110,6 +115,10 @@ int world_bonds(lua_State* L) {
       vec("bending_moment", b.bending_moment);
       num("sigma", b.sigma);
       num("tau", b.tau);
+      lua_pushboolean(L, b.beam);
+      lua_setfield(L, -2, "beam");
+      lua_pushboolean(L, b.contact_bond);
+      lua_setfield(L, -2, "contact_bond");
       lua_rawseti(L, -2, static_cast<lua_Integer>(k + 1));
     }
     return 1;
@@ -139,6 +148,8 @@ int world_break_events(lua_State* L) {
       lua_setfield(L, -2, "b");
       lua_pushstring(L, break_mode_name(e.mode));
       lua_setfield(L, -2, "mode");
+      lua_pushstring(L, break_kind_name(e.kind));
+      lua_setfield(L, -2, "kind");
       lua_pushnumber(L, e.sigma);
       lua_setfield(L, -2, "sigma");
       lua_pushnumber(L, e.tau);
@@ -151,9 +162,20 @@ int world_break_events(lua_State* L) {
   });
 }
 
+// world:break_count([kind]): "beam" (the default: the thesis's broken bonds), "contact_bond",
+// or "all" (every event: the numbering of world:break_events).
 int world_break_count(lua_State* L) {
   return guarded(L, [&] {
-    lua_pushinteger(L, static_cast<lua_Integer>(world_arg(L).break_events().size()));
+    const std::vector<BreakEvent>& events = world_arg(L).break_events();
+    const std::string kind = lua_isnoneornil(L, 2) ? "beam" : check_string(L, 2);
+    if (kind != "beam" && kind != "contact_bond" && kind != "all")
+      throw ArgError{2, "kind must be \"beam\", \"contact_bond\" or \"all\", got \"" + kind + "\""};
+    std::size_t n = events.size();
+    if (kind != "all") {
+      n = 0;
+      for (const BreakEvent& e : events) n += kind == break_kind_name(e.kind);
+    }
+    lua_pushinteger(L, static_cast<lua_Integer>(n));
     return 1;
   });
 }
@@ -205,21 +227,28 @@ std::span<const Function> world_bond_methods() {
        "world:install_bonds{tensile_strength= | breakable=false [, beam_kn=] [, beam_ks=]\n"
        "  [, radius_factor=] [, tolerance=] [, ids=] [, stress_free=false]} -> count",
        install_bonds_help()},
-      {"bond_count", world_bond_count, "world:bond_count() -> n", "Intact bonds."},
+      {"bond_count", world_bond_count, "world:bond_count() -> n",
+       "Parallel bonds that hold (a pair held by its contact bond alone is not counted)."},
       {"set_bond_strength", world_set_bond_strength,
-       "world:set_bond_strength{tensile_strength= | breakable=false}",
-       "Changes the strength of every bond (stiffness and stored forces unchanged)."},
+       "world:set_bond_strength{tensile_strength= | breakable=false [, contact_strength=]}",
+       "Changes the strength of every bond (stiffness and stored forces unchanged); contact_strength\n"
+       "(c: the contact bond breaks at c st A; 0 with the beam, math.huge never) stays as it is\n"
+       "unless given."},
       {"remove_bonds", world_remove_bonds, "world:remove_bonds()",
        "Deletes every bond (no break events; bonded pairs become ordinary contacts)."},
       {"save", world_save, "world:save(path)",
        "Writes a checkpoint (the whole state, HDF5); asperity.load(path) continues bit for bit."},
       {"bonds", world_bonds, "world:bonds() -> {bond, ...}",
-       "Intact bonds: {a, b, normal, point, gap, beam_radius, normal_force, shear_force,\n"
-       "twisting_moment, bending_moment, sigma, tau}."},
+       "Bonds of which a part holds: {a, b, normal, point, gap, beam_radius, normal_force,\n"
+       "shear_force, twisting_moment, bending_moment, sigma, tau, beam, contact_bond}; beam and\n"
+       "contact_bond say which part holds (model.md 5: they break separately)."},
       {"break_events", world_break_events, "world:break_events([first]) -> {event, ...}",
-       "Bond breaks so far (from number `first`): {step, time, position, a, b, mode, sigma, tau,\n"
-       "released_energy}; mode is \"tension\", \"compression\" or \"shear\"."},
-      {"break_count", world_break_count, "world:break_count() -> n", "Bond breaks so far."},
+       "Bond breaks so far (from number `first`): {step, time, position, a, b, kind, mode, sigma,\n"
+       "tau, released_energy}; kind is \"beam\" (the parallel bond) or \"contact_bond\", mode\n"
+       "\"tension\", \"compression\" or \"shear\"."},
+      {"break_count", world_break_count, "world:break_count([kind]) -> n",
+       "Breaks so far of kind \"beam\" (the default: parallel bonds, the thesis's broken bonds),\n"
+       "\"contact_bond\", or \"all\" (the numbering of world:break_events)."},
   };
   return methods;
 }

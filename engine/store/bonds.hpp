@@ -11,11 +11,17 @@
 
 #include "asperity/materials.hpp"
 #include "core/aligned.hpp"
+#include "kernels/kernels.hpp"
 #include "store/columns.hpp"
 
 namespace asperity::detail {
 
 inline constexpr std::size_t kBondRecord = 12;  // doubles per bond in BondStore::out
+
+// What of a bond still holds (BondStore::holds; the bond kernel's encoding, kernels.hpp).
+using kernels::kBeamHolds;
+using kernels::kBothHold;
+using kernels::kContactBondHolds;
 
 struct BondStore {
   std::size_t n = 0;
@@ -32,8 +38,13 @@ struct BondStore {
   AVec<double> fbsx, fbsy, fbsz;          // parallel bond shear force
   AVec<double> mbn;                       // twisting moment (along n)
   AVec<double> mbsx, mbsy, mbsz;          // bending moment
-  AVec<double> broken;                    // 1 when the criterion was met this step; 0 between
-                                          // steps (the kernel writes only where one breaks)
+  AVec<double> holds;                     // kBeamHolds | kContactBondHolds (installed: both).
+                                          // Without the beam its forces and moments are 0;
+                                          // without the contact bond the contact springs follow
+                                          // the ordinary contact law (model.md 4)
+  AVec<double> broken;                    // what broke this step (kBeamHolds | kContactBondHolds
+                                          // of the parts that broke); 0 between steps (the
+                                          // kernel writes only where one breaks)
   // For the gather, computed by the SIMD kernel (outputs of the step only, like PairStore's): the
   // record of bond k is out[kBondRecord k + j], j = 0..11: fx fy fz U cx cy cz 0 mx my mz 0, the
   // force on b (fn + fbn) n + fs + fbs, the overlap, n x (fs + fbs) (torque per lever arm,
@@ -58,6 +69,7 @@ struct BondStore {
     f(ColumnInfo{"mbsx", 0, true}, q.mbsx...);
     f(ColumnInfo{"mbsy", 0, true}, q.mbsy...);
     f(ColumnInfo{"mbsz", 0, true}, q.mbsz...);
+    f(ColumnInfo{"holds", kBothHold, false, 9}, q.holds...);
     f(ColumnInfo{"broken", 0}, q.broken...);
   }
 

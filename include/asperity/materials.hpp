@@ -23,13 +23,18 @@ struct ContactMaterial {
 
 // Contact bond + parallel bond installed together (model.md 5). The beam of radius
 // Rb = radius_factor * min(Ra, Rb) acts as springs of stiffness kbn A = beam_kn and kbs A = beam_ks
-// (defaults: as stiff as the contact springs, kbs = kbn / 10).
+// (defaults: as stiff as the contact springs, kbs = kbn / 10). The two break separately: the
+// beam by the elliptic criterion, the contact bond when its tensile normal force or its shear
+// force reaches c st A (PFC's contact bond, Fcn = Fcs = c st A, A the beam's area), where
+// c = contact_strength; c = inf: it never breaks; c = 0: it breaks with the beam (the pair
+// becomes an ordinary contact the step its beam breaks, and never breaks on its own).
 struct BondMaterial {
   double beam_kn = 0.1;            // kbn * A, N/m
   double beam_ks = 0.01;           // kbs * A, N/m
   double radius_factor = 1.0;      // lambda
   double tensile_strength = 0.0;   // st, Pa (elliptic criterion [3-46..3-49])
   bool breakable = true;           // false: the elastic model (bonds never break)
+  double contact_strength = 0.0;   // c: Fcn = Fcs = c st A; 0: breaks with the beam
   bool operator==(const BondMaterial&) const = default;
 };
 
@@ -61,6 +66,9 @@ void for_each_field(Material& m, Visit&& visit) {
               "st, Pa (elliptic criterion [3-46..3-49])"},
         m.tensile_strength);
   visit(Field{"breakable", "breakable", 1, {}, "false: the elastic model (bonds never break)"}, m.breakable);
+  visit(Field{"contact_strength", "contact_strength", 9, {0, inf, true, false, "breaks with the beam"},
+              "c: the contact bond breaks at a tensile or shear force c st A (model.md 5), inf never"},
+        m.contact_strength);
 }
 
 }  // namespace asperity

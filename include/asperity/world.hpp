@@ -16,6 +16,7 @@
 #include <span>
 #include <string>
 #include <type_traits>
+#include <optional>
 #include <vector>
 
 #include "asperity/error.hpp"
@@ -217,7 +218,7 @@ struct ContactSummary {
   Vec3 flagged_force{0, 0, 0};
 };
 
-struct BondInfo {  // one intact bond, for inspection and output
+struct BondInfo {  // one bond of which some part holds, for inspection and output
   std::int64_t id_a, id_b;    // id_a < id_b; forces act on b, their negatives on a
   Vec3 normal;                // unit, from a to b
   Vec3 point;                 // contact point
@@ -228,6 +229,9 @@ struct BondInfo {  // one intact bond, for inspection and output
   double twisting_moment;     // Mbn (along the normal)
   Vec3 bending_moment;        // Mbs
   double sigma, tau;          // periphery stresses [3-27], tension positive, Pa
+  bool beam = true;           // the parallel bond holds (else its forces and moments are 0)
+  bool contact_bond = true;   // the contact bond holds (else the contact springs are an
+                              // ordinary contact: no tension, Coulomb slip)
 };
 
 struct BreakEvent {  // model.md 5: every break
@@ -235,11 +239,14 @@ struct BreakEvent {  // model.md 5: every break
   double time;
   Vec3 position;              // contact point
   std::int64_t id_a, id_b;
-  // Which stress was nearest its own failure value (st in tension, 10 st in compression, 5 st
-  // in shear).
+  // Which stress was nearest its own failure value (beam: st in tension, 10 st in compression,
+  // 5 st in shear; contact bond: tension where its tensile force reached c st A, else shear).
   enum class Mode : std::uint8_t { tension, compression, shear } mode;
-  double sigma, tau;          // at the break
-  double released_energy;     // strain energy of the bond that was not kept by a contact, J
+  // What broke: the parallel bond (the thesis's "broken bonds"; with contact_strength 0 the
+  // contact bond goes with it) or the contact bond on its own.
+  enum class Kind : std::uint8_t { beam, contact_bond } kind = Kind::beam;
+  double sigma, tau;          // at the break (contact bond: -Fn / A and |Fs| / A)
+  double released_energy;     // strain energy of the part that was not kept by a contact, J
 };
 
 struct Energies {            // model.md 8; all in J
@@ -406,10 +413,12 @@ class World {
   // stresses a jammed packing would lock into the bonds (scripts/README.md, "The REV").
   std::size_t install_bonds(const BondMaterial& material, double tolerance = -1,
                             std::span<const std::int64_t> ids = {}, bool stress_free = false);
-  std::size_t bond_count() const;                   // intact bonds
+  std::size_t bond_count() const;                   // parallel bonds that hold
   // Change the strength of every bond (e.g. unbreakable while a specimen is prepared, then the
-  // calibrated strength for the fracture model). Stiffness and stored forces are unchanged.
-  void set_bond_strength(double tensile_strength, bool breakable);
+  // calibrated strength for the fracture model), and, where given, the contact bond's strength
+  // factor c (BondMaterial::contact_strength). Stiffness and stored forces are unchanged.
+  void set_bond_strength(double tensile_strength, bool breakable,
+                         std::optional<double> contact_strength = std::nullopt);
   void remove_bonds();                              // all of them (no events, no energy booked)
   std::vector<BondInfo> bonds() const;
   const std::vector<BreakEvent>& break_events() const;

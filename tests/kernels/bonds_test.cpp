@@ -531,7 +531,7 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
   AVec<double> x(n), y(n), z(n), vx(n), vy(n), vz(n), wx(n), wy(n), wz(n), r(n);
   AVec<std::int64_t> a(bonds), b(bonds);
   AVec<double> rb(bonds);
-  std::vector<AVec<double>> hist(28, AVec<double>(bonds));  // 27: rest overlaps; 16, 18..26 unused
+  std::vector<AVec<double>> hist(29, AVec<double>(bonds));  // 27: rest overlaps, 28: what holds; 16, 18..26 unused
   for (std::size_t i = 0; i < n; ++i) {
     r[i] = kR * (1 + 0.3 * u(rng));
     vx[i] = 1e-3 * u(rng); vy[i] = 1e-3 * u(rng); vz[i] = 1e-3 * u(rng);
@@ -551,10 +551,13 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
     for (int c = 3; c < 12; ++c) hist[c][k] = 1e-6 * u(rng);
     for (int c = 12; c < 16; ++c) hist[c][k] = 1e-10 * u(rng);
     hist[27][k] = (k % 3 == 0) ? 0.01 * r[ia] * u(rng) : 0.0;  // rest overlaps, stress-free bonds
+    hist[28][k] = double(1 + k % 3);  // beam only, contact bond only, both (BondStore::holds)
   }
-  // kernel: 0 the full law, 1 without spin, 2 without spin and beam moments.
+  // kernel: 0 the full law, 1 without spin, 2 without spin and beam moments. partial: bonds that
+  // lost their beam or their contact bond, contact bonds of strength 2 st A (else every bond
+  // holds both, and the contact bond breaks with the beam).
   auto run = [&](const kernels::KernelSet& ks, std::vector<AVec<double>> h, bool rest,
-                 int kernel = 0) {
+                 int kernel = 0, bool partial = false) {
     kernels::BondKernelArgs args{x.data(), y.data(), z.data(), vx.data(), vy.data(), vz.data(),
                                  wx.data(), wy.data(), wz.data(), r.data(), a.data(), b.data(),
                                  rb.data(), h[0].data(), h[1].data(), h[2].data(), h[3].data(),
@@ -563,12 +566,17 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
                                  h[13].data(), h[14].data(), h[15].data(), h[17].data(),
                                  nullptr, 0.1, 0.01, 0.1, 0.01, 1e-3, 1.0, n,
                                  rest ? h[27].data() : nullptr};
+    if (partial) {
+      args.holds = h[28].data();
+      args.friction = 0.5;
+      args.contact_strength = 2.0;
+    }
     // The gather's records (store/bonds.hpp): every slot written, the pads with 0; records of 8
     // (no moment) from the kernel without moments, whose slots beyond them stay untouched.
     const std::size_t width = kernel == 2 ? 8 : 12;
     AVec<double> records(12 * bonds, -7.0);
     args.out = records.data();
-    const double broken = (kernel == 0 ? ks.bond : kernel == 1 ? ks.bond_norot : ks.bond_no_moment)(args, 0, bonds);
+    const kernels::BondSums broken = (kernel == 0 ? ks.bond : kernel == 1 ? ks.bond_norot : ks.bond_no_moment)(args, 0, bonds);
     // Record column j as a column of its own (18 + j for the force, overlap and n x Fs, then
     // the moment: -1 where the record has none), so the comparisons below see them.
     for (std::size_t k = 0; k < bonds; ++k) {
@@ -588,21 +596,32 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
     }
     return std::make_pair(broken, h);
   };
-  for (bool rest : {false, true}) {
-    const auto ref = run(kernels::scalar_kernels(), hist, rest);
-    ASSERT_GT(ref.first, 0.0) << "some random bonds must break";
-    ASSERT_LT(ref.first, double(bonds)) << "and some must hold";
+  for (int variant = 0; variant < 4; ++variant) {
+    const bool rest = variant % 2 == 1, partial = variant >= 2;
+    const auto ref = run(kernels::scalar_kernels(), hist, rest, 0, partial);
+    ASSERT_GT(ref.first.breaks, 0.0) << "some random bonds must break";
+    ASSERT_LT(ref.first.breaks, double(bonds)) << "and some must hold";
+    if (partial) {
+      EXPECT_GT(ref.first.slip, 0.0) << "contact springs without their contact bond slip";
+      bool contact_breaks = false;
+      for (std::size_t k = 0; k < bonds; ++k) contact_breaks = contact_breaks || ref.second[17][k] >= 2;
+      EXPECT_TRUE(contact_breaks) << "some contact bonds break on their own";
+    } else {
+      EXPECT_EQ(ref.first.slip, 0.0) << "intact contact bonds do not slip";
+    }
     if (rest) {
       const auto without = run(kernels::scalar_kernels(), hist, false);
       EXPECT_NE(0, std::memcmp(without.second[6].data(), ref.second[6].data(), bonds * sizeof(double)))
           << "the rest overlaps change the contact bond's normal force";
     }
     for (const auto& arch : available_simd_architectures()) {
-      const auto got = run(kernels::select_kernels(arch), hist, rest);
-      EXPECT_EQ(got.first, ref.first) << arch;
-      for (int c = 0; c < 28; ++c)
+      const auto got = run(kernels::select_kernels(arch), hist, rest, 0, partial);
+      EXPECT_EQ(got.first.breaks, ref.first.breaks) << arch;
+      // The slip energy is summed per lane first: equal to rounding (like the pair kernel's).
+      EXPECT_NEAR(got.first.slip, ref.first.slip, 1e-12 * ref.first.slip) << arch;
+      for (int c = 0; c < 29; ++c)
         EXPECT_EQ(0, std::memcmp(got.second[c].data(), ref.second[c].data(), bonds * sizeof(double)))
-            << arch << " column " << c << (rest ? " rest" : "");
+            << arch << " column " << c << (rest ? " rest" : "") << (partial ? " partial" : "");
     }
   }
   // With every angular velocity +0 (bonded particles do not rotate), the kernel that does not
@@ -611,7 +630,7 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
   for (const auto& arch : available_simd_architectures()) {
     const auto& ks = kernels::select_kernels(arch);
     const auto full = run(ks, hist, true, 0), shortcut = run(ks, hist, true, 1);
-    EXPECT_EQ(full.first, shortcut.first) << arch;
+    EXPECT_EQ(full.first.breaks, shortcut.first.breaks) << arch;
     for (int c = 0; c < 28; ++c)
       EXPECT_EQ(0, std::memcmp(full.second[c].data(), shortcut.second[c].data(), bonds * sizeof(double)))
           << arch << " column " << c;
@@ -626,8 +645,8 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
   for (const auto& arch : available_simd_architectures()) {
     const auto& ks = kernels::select_kernels(arch);
     const auto carried = run(ks, hist, true, 1), unmoved = run(ks, hist, true, 2);
-    EXPECT_EQ(carried.first, unmoved.first) << arch;
-    EXPECT_GT(unmoved.first, 0.0) << "the criterion still breaks bonds";
+    EXPECT_EQ(carried.first.breaks, unmoved.first.breaks) << arch;
+    EXPECT_GT(unmoved.first.breaks, 0.0) << "the criterion still breaks bonds";
     for (int c = 0; c < 28; ++c) {
       const auto& got = unmoved.second[c];
       EXPECT_EQ(0, std::memcmp(got.data(), no_moment_ref.second[c].data(), bonds * sizeof(double)))
