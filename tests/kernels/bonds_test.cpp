@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <tuple>
@@ -252,6 +253,183 @@ TEST(Bonds, ShearBreaksAtFiveTimesTheStrength) {
   const double per_step = 0.01 * 1e-6 * p.w.dt() / kArea;  // tau gained per step
   EXPECT_GE(World::bond_criterion(ev.sigma, ev.tau, 5e-4), 1.0);
   EXPECT_LT(World::bond_criterion(ev.sigma, ev.tau - 1.0001 * per_step, 5e-4), 1.0);
+}
+
+// --- the contact bond, which breaks apart from the beam (model.md 5: Fcn = Fcs = c st A) -------
+
+std::size_t breaks_of(const World& w, BreakEvent::Kind kind) {
+  return std::size_t(std::count_if(w.break_events().begin(), w.break_events().end(),
+                                   [&](const BreakEvent& e) { return e.kind == kind; }));
+}
+
+// Pulled apart: the beam breaks at sigma = st (its force beam_kn delta = st A), the contact bond
+// then holds alone, in tension, to kn delta = c st A; each break releases its own part's energy.
+TEST(ContactBonds, PulledApartTheBeamBreaksAtStAndTheContactBondAtCStA) {
+  BondMaterial bm;
+  bm.tensile_strength = 2.0;  // Pa
+  bm.contact_strength = 3.0;  // c
+  const double v = 1e-6;
+  Pair p = bonded_pair(bm, moving({0, 0, v}));
+  const Energies e0 = p.w.energies();
+  while (p.w.break_events().empty() && p.w.step_count() < 1000000) p.w.cycle(1);
+  ASSERT_EQ(p.w.break_events().size(), 1u);
+  const BreakEvent beam = p.w.break_events()[0];
+  EXPECT_EQ(beam.kind, BreakEvent::Kind::beam);
+  EXPECT_EQ(beam.mode, BreakEvent::Mode::tension);
+  const double per_step = 0.1 * v * p.w.dt() / kArea;  // sigma gained per step
+  EXPECT_GE(beam.sigma, 2.0);
+  EXPECT_LT(beam.sigma, 2.0 + 1.0001 * per_step);
+  const double fbn = beam.sigma * kArea;
+  EXPECT_NEAR(beam.released_energy, fbn * fbn / (2 * 0.1), 1e-9 * beam.released_energy)
+      << "the beam's energy only: the contact bond keeps its own";
+  EXPECT_EQ(p.w.bond_count(), 0u) << "no parallel bond holds";
+  ASSERT_EQ(p.w.bonds().size(), 1u) << "the contact bond still ties the pair";
+  EXPECT_FALSE(p.w.bonds()[0].beam);
+  EXPECT_TRUE(p.w.bonds()[0].contact_bond);
+  // The contact bond alone: Fn = kn U in tension, nothing from the beam.
+  p.w.cycle(100);
+  const BondInfo held = p.w.bonds()[0];
+  EXPECT_NEAR(held.normal_force, 0.1 * -held.gap, 1e-9 * std::fabs(held.normal_force));
+  EXPECT_LT(held.normal_force, 0.0);
+  while (p.w.break_events().size() == 1 && p.w.step_count() < 2000000) p.w.cycle(1);
+  ASSERT_EQ(p.w.break_events().size(), 2u);
+  const BreakEvent contact = p.w.break_events()[1];
+  EXPECT_EQ(contact.kind, BreakEvent::Kind::contact_bond);
+  EXPECT_EQ(contact.mode, BreakEvent::Mode::tension);
+  EXPECT_GE(contact.sigma, 3.0 * 2.0) << "-Fn / A reaches c st";
+  EXPECT_LT(contact.sigma, 3.0 * 2.0 + 1.0001 * per_step);
+  const double fn = contact.sigma * kArea;
+  EXPECT_NEAR(contact.released_energy, fn * fn / (2 * 0.1), 1e-9 * contact.released_energy)
+      << "apart: the contact keeps nothing";
+  EXPECT_TRUE(p.w.bonds().empty());
+  const Energies e = p.w.energies();
+  EXPECT_NEAR(e.released - e0.released, beam.released_energy + contact.released_energy,
+              1e-12 * e.released);
+  EXPECT_EQ(e.strain, 0.0);
+  EXPECT_LT(std::fabs(e.balance_error(e0)), 1e-3 * (e.boundary_work - e0.boundary_work));
+  EXPECT_EQ(p.w.contact_count(), 0u);
+}
+
+// However hard it is pressed, a contact bond does not break (its beam does, at -10 st); pulled
+// back it breaks in tension at c st A. With c = inf it never breaks.
+TEST(ContactBonds, CompressionNeverBreaksAContactBond) {
+  for (const double c : {0.01, std::numeric_limits<double>::infinity()}) {
+    BondMaterial bm;
+    bm.tensile_strength = 0.2;
+    bm.contact_strength = c;
+    const double v = 1e-6;
+    Pair p = bonded_pair(bm, moving({0, 0, -v}));
+    while (p.w.break_events().empty() && p.w.step_count() < 1000000) p.w.cycle(1);
+    ASSERT_EQ(p.w.break_events().size(), 1u);
+    EXPECT_EQ(p.w.break_events()[0].kind, BreakEvent::Kind::beam);
+    EXPECT_EQ(p.w.break_events()[0].mode, BreakEvent::Mode::compression);
+    // Pressed on to twice the beam's failure strain: Fn = kn U, 2000 times c st A for c = 0.01.
+    const std::uint64_t at = p.w.step_count();
+    p.w.cycle(at);
+    ASSERT_EQ(p.w.bonds().size(), 1u);
+    EXPECT_GT(p.w.bonds()[0].normal_force, 1000 * 0.01 * 0.2 * kArea);
+    EXPECT_EQ(breaks_of(p.w, BreakEvent::Kind::contact_bond), 0u) << "compression never breaks it";
+    // Pulled back until the spheres are 10 % of a radius apart.
+    p.w.set_group_motion(p.gb, moving({0, 0, 20 * v}));
+    while (p.w.position(p.b).z < 2.1 * kR && p.w.step_count() < 10000000) p.w.cycle(1);
+    if (std::isinf(c)) {
+      EXPECT_EQ(breaks_of(p.w, BreakEvent::Kind::contact_bond), 0u) << "c = inf: never";
+      ASSERT_EQ(p.w.bonds().size(), 1u);
+      EXPECT_NEAR(p.w.bonds()[0].normal_force, -0.1 * p.w.bonds()[0].gap, 1e-9 * 0.01 * kR)
+          << "still pulling with kn U";
+    } else {
+      ASSERT_EQ(breaks_of(p.w, BreakEvent::Kind::contact_bond), 1u);
+      const BreakEvent& ev = p.w.break_events()[1];
+      EXPECT_EQ(ev.mode, BreakEvent::Mode::tension);
+      EXPECT_GE(ev.sigma, c * 0.2);
+      EXPECT_LT(ev.sigma, c * 0.2 + 1.0001 * 0.1 * 20 * v * p.w.dt() / kArea);
+      EXPECT_TRUE(p.w.bonds().empty());
+    }
+  }
+}
+
+// Sheared under a small compression: the contact bond breaks when its shear force reaches
+// c st A (the beam, at tau = st then, holds), and the contact springs carry on as an ordinary
+// contact, their shear force capped at mu Fn, the slip dissipated booked as friction.
+TEST(ContactBonds, ShearBreaksTheContactBondAtCStAAndLeavesFriction) {
+  const double st = 0.02, c = 1.0, u0 = 1e-4 * kR, v = 1e-6;
+  WorldSettings ws;
+  ws.local_damping = 0;
+  World w(ws);
+  const auto a = w.add_particle({0, 0, 0}, kR);
+  const auto b = w.add_particle({0, 0, 2 * kR - u0}, kR);
+  BondMaterial bm;
+  bm.tensile_strength = st;
+  bm.contact_strength = c;
+  ASSERT_EQ(w.install_bonds(bm), 1u);
+  GroupMotion fixed;
+  fixed.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
+  w.add_group(std::vector<std::int64_t>{a}, fixed);
+  w.add_group(std::vector<std::int64_t>{b}, moving({v, 0, 0}));
+  w.set_dt(1e-4);
+  const Energies e0 = w.energies();
+  while (w.break_events().empty() && w.step_count() < 1000000) w.cycle(1);
+  ASSERT_EQ(w.break_events().size(), 1u);
+  const BreakEvent& ev = w.break_events()[0];
+  EXPECT_EQ(ev.kind, BreakEvent::Kind::contact_bond);
+  EXPECT_EQ(ev.mode, BreakEvent::Mode::shear);
+  const double per_step = 0.01 * v * w.dt() / kArea;  // |Fs| / A gained per step
+  EXPECT_GE(ev.tau, c * st);
+  EXPECT_LT(ev.tau, c * st + 1.0001 * per_step);
+  EXPECT_EQ(w.energies().friction, e0.friction) << "no slip while the contact bond held";
+  w.cycle(1000);
+  ASSERT_EQ(w.bonds().size(), 1u);
+  EXPECT_TRUE(w.bonds()[0].beam) << "the beam holds: tau = st is far from 5 st";
+  EXPECT_FALSE(w.bonds()[0].contact_bond);
+  const detail::State& s = w.state();
+  const double fn = s.bonds.fn[0];
+  const double fs = std::sqrt(s.bonds.fsx[0] * s.bonds.fsx[0] + s.bonds.fsy[0] * s.bonds.fsy[0] +
+                              s.bonds.fsz[0] * s.bonds.fsz[0]);
+  EXPECT_NEAR(fn, 0.1 * s.bonds.overlap[0], 1e-9 * fn) << "Fn = kn U: still pressed";
+  EXPECT_GT(fn, 0.0);
+  EXPECT_NEAR(fs, 0.5 * fn, 1e-9 * fs) << "slipping at mu Fn";
+  // Slip per step: mu Fn (|Fs_trial| - mu Fn) / ks with |Fs_trial| - mu Fn = ks v dt.
+  const double friction = w.energies().friction - e0.friction;
+  EXPECT_NEAR(friction, 1000 * 0.5 * fn * v * w.dt(), 0.01 * friction);
+  const Energies e = w.energies();
+  EXPECT_LT(std::fabs(e.balance_error(e0)), 1e-3 * (e.boundary_work - e0.boundary_work));
+}
+
+// A checkpoint keeps what of each bond holds and the kind of each break: the loaded world goes
+// on bit for bit.
+TEST(ContactBonds, ACheckpointKeepsWhatHolds) {
+  BondMaterial bm;
+  bm.tensile_strength = 2.0;
+  bm.contact_strength = 3.0;
+  Pair p = bonded_pair(bm, moving({0, 0, 1e-6}));
+  while (p.w.break_events().empty() && p.w.step_count() < 1000000) p.w.cycle(1);
+  const std::string path = ::testing::TempDir() + "/contact_bond_only.h5";
+  p.w.save(path);
+  World loaded = World::load(path, 1, "auto");
+  ASSERT_EQ(loaded.bonds().size(), 1u);
+  EXPECT_FALSE(loaded.bonds()[0].beam);
+  EXPECT_TRUE(loaded.bonds()[0].contact_bond);
+  EXPECT_EQ(loaded.break_events()[0].kind, BreakEvent::Kind::beam);
+  for (World* w : {&p.w, &loaded})
+    while (w->break_events().size() == 1 && w->step_count() < 2000000) w->cycle(1);
+  ASSERT_EQ(loaded.break_events().size(), 2u);
+  EXPECT_EQ(loaded.break_events()[1].kind, BreakEvent::Kind::contact_bond);
+  EXPECT_EQ(loaded.break_events()[1].step, p.w.break_events()[1].step);
+  EXPECT_EQ(loaded.break_events()[1].sigma, p.w.break_events()[1].sigma);
+}
+
+// c = 0 is the earlier model: the contact bond breaks with the beam, one event, the pair an
+// ordinary contact at once.
+TEST(ContactBonds, ZeroBreaksTheContactBondWithTheBeam) {
+  BondMaterial bm;
+  bm.tensile_strength = 0.2;
+  bm.contact_strength = 0;
+  Pair p = bonded_pair(bm, moving({0, 0, -1e-6}));
+  while (p.w.break_events().empty() && p.w.step_count() < 1000000) p.w.cycle(1);
+  ASSERT_EQ(p.w.break_events().size(), 1u);
+  EXPECT_EQ(p.w.break_events()[0].kind, BreakEvent::Kind::beam);
+  EXPECT_TRUE(p.w.bonds().empty());
+  EXPECT_EQ(p.w.stats().pairs, 1u) << "an ordinary contact now";
 }
 
 TEST(Bonds, BondedOscillatorHasThePeriodOfTheCombinedStiffness) {
