@@ -90,6 +90,8 @@ local P = params_lib.parse{
   {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "thesis definition [3-35]: the particle count of the genesis"},
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "isotropic stress installed before bonding (scenarios.md 1; model units)"},
   {"bond_gap", 0, unit = "m", min = 0, doc = "largest gap bonded (0: the engine's default, 1e-3 x mean radius)"},
+  {"contact_strength", mat.rev.contact_strength, type = "string",
+   doc = "fracture model: the contact bonds break at c st A: c > 0, \"inf\" (never) or \"beam\" (with the parallel bond) (model.md 5)"},
   {"wall_friction", 0, min = 0, doc = "of the box walls and the mould during the genesis (scenarios.md 1: frictionless)"},
   {"seed", 1, type = "integer", min = 0, doc = "of the surface and the packing"},
   {"pack_steps", 300000, type = "integer", min = 1, doc = "most steps spent cycling the packing towards the ratio 1e-4"},
@@ -119,6 +121,8 @@ local P = params_lib.parse{
                      .. "mean over the last residual_window of the shear"):format(P.residual_window))
     end
     if P.record >= P.shear then fail("record", ("must be < shear (%g mm)"):format(P.shear)) end
+    local _, why = mat.contact_strength(P.contact_strength)
+    if why then fail("contact_strength", why) end
     if P.ramp >= P.shear then fail("ramp", ("must be < shear (%g mm)"):format(P.shear)) end
     if P.speedup > 1 and P.model == "fracture" then
       fail("speedup", "is not for the fracture model: its results depend on the loading rate already at "

@@ -66,6 +66,8 @@ local P = params_lib.parse{
    doc = "bond strength st of the elliptic criterion (model units; the calibrated one by default)"},
   {"bond_shear_ratio", rev.bond_shear_ratio, min = 0, doc = "kbs / kbn of the parallel bonds"},
   {"bond_radius_factor", rev.bond_radius_factor, above = 0, max = 1, doc = "lambda: Rb = lambda min(Ra, Rb) [3-26]"},
+  {"contact_strength", rev.contact_strength, type = "string",
+   doc = "the contact bonds break at c st A: c > 0, \"inf\" (never) or \"beam\" (with the parallel bond) (model.md 5)"},
   {"rate", 1e-6, unit = "m/s", above = 0, doc = "platen velocity (thesis: 1 um/s)"},
   {"elastic_strain", 2e-4, above = 0, below = 0.1, doc = "strain reached in the elastic tests"},
   {"stop_fraction", 0.7, above = 0, below = 1, doc = "fracture tests stop when |stress| < this x peak, after the peak"},
@@ -92,6 +94,8 @@ local P = params_lib.parse{
       fail("radius_sd", ("must be < mean_radius / 3 (%g m): radii are cut at 3 SD and must stay positive"):format(P.mean_radius / 3))
     end
     if #params_lib.split(P.tests) == 0 then fail("tests", "must name at least one test") end
+    local _, why = mat.contact_strength(P.contact_strength)
+    if why then fail("contact_strength", why) end
   end,
 }
 if not P then return end   -- help printed
@@ -197,7 +201,8 @@ local function bonded(material, csv, axis)
              bond_stress = b.bond_stress}
 end
 
-local bond_material = {beam_kn = P.kn, beam_ks = P.kn * P.bond_shear_ratio, radius_factor = P.bond_radius_factor}
+local bond_material = {beam_kn = P.kn, beam_ks = P.kn * P.bond_shear_ratio, radius_factor = P.bond_radius_factor,
+                       contact_strength = (mat.contact_strength(P.contact_strength))}
 if P.bond_gap > 0 then bond_material.tolerance = P.bond_gap end   -- else the engine's 1e-3 <R>
 local function with(t, extra)
   local c = {}
@@ -428,21 +433,23 @@ local fracture
 local function break_map(w, name, title)
   local events = w:break_events()
   local f = assert(io.open(out .. "/" .. name .. "_breaks.csv", "w"))
-  f:write("step,time [s],x [m],y [m],z [m],a,b,mode,sigma [Pa (model)],tau [Pa (model)],released_energy [J]\n")
+  f:write("step,time [s],x [m],y [m],z [m],a,b,kind,mode,sigma [Pa (model)],tau [Pa (model)],released_energy [J]\n")
   local modes = {tension = 1, shear = 2, compression = 3}
   local pts = {}
   for _, e in ipairs(events) do
     local p = e.position
-    f:write(("%d,%.10g,%.10g,%.10g,%.10g,%d,%d,%s,%.10g,%.10g,%.10g\n"):format(
-      e.step, e.time, p.x, p.y, p.z, e.a, e.b, e.mode, e.sigma, e.tau, e.released_energy))
-    pts[#pts + 1] = {p.x, p.y, p.z, modes[e.mode]}
+    f:write(("%d,%.10g,%.10g,%.10g,%.10g,%d,%d,%s,%s,%.10g,%.10g,%.10g\n"):format(
+      e.step, e.time, p.x, p.y, p.z, e.a, e.b, e.kind, e.mode, e.sigma, e.tau, e.released_energy))
+    if e.kind == "beam" then pts[#pts + 1] = {p.x, p.y, p.z, modes[e.mode]} end
   end
   f:close()
   local ext = specimen.extent(w)
   figures.map{file = out .. "/" .. name .. "_breaks.png", points = pts, groups = {"tension", "shear", "compression"},
               extent = ext, title = title}
   local counts = {tension = 0, shear = 0, compression = 0}
-  for _, e in ipairs(events) do counts[e.mode] = counts[e.mode] + 1 end
+  for _, e in ipairs(events) do
+    if e.kind == "beam" then counts[e.mode] = counts[e.mode] + 1 end
+  end
   return counts
 end
 

@@ -143,6 +143,12 @@ function M.analyse_run(folder)
   breaks = breaks or {step = {}, released_energy = {}}
   local r = {folder = folder}
   local steps, energies = breaks.step, breaks.released_energy
+  if breaks.kind then  -- the parallel bonds' breaks only (the thesis's events); 2: a contact bond's
+    steps, energies = {}, {}
+    for i, k in ipairs(breaks.kind) do
+      if k == 1 then steps[#steps + 1], energies[#energies + 1] = breaks.step[i], breaks.released_energy[i] end
+    end
+  end
   -- The intervals and the break count of each.
   local edges, counts = {}, {}
   if ev and #ev.step >= 2 then

@@ -45,6 +45,9 @@ M.rev = {
   -- A bonded particle none of whose bonds broke does not rotate; a damaged one while it still
   -- holds this many (model.md 2; kernels/bonds.cpp).
   rotation_lock_bonds = 3,
+  -- The contact bond's strength factor c (model.md 5: Fcn = Fcs = c st A): "beam" breaks it with
+  -- the parallel bond (the material calibrated so far), "inf" never, a number > 0 at c st A.
+  contact_strength = "beam",
   calibration = {seeds = {1, 2, 3, 4, 5},
                  young_modulus_pa = {mean = 91.739, sd = 3.960},
                  poisson_ratio = {mean = 0.18801, sd = 0.00658},
@@ -53,12 +56,24 @@ M.rev = {
                  strength_ratio = {mean = 10.432, sd = 0.406}},
 }
 
+-- The contact bond's strength factor as a script gives it ("beam", "inf" or a number > 0) ->
+-- the number the engine takes (BondMaterial::contact_strength: 0 breaks with the beam,
+-- math.huge never); nil and what is allowed for anything else.
+function M.contact_strength(text)
+  if text == "beam" then return 0 end
+  if text == "inf" then return math.huge end
+  local c = tonumber(text)
+  if c and c > 0 and c < math.huge then return c end
+  return nil, "must be \"beam\" (breaks with the parallel bond), \"inf\" (never breaks) or a number > 0 (c of c st A)"
+end
+
 -- Bond material for world:install_bonds: beams as stiff in tension as the contact springs
 -- (kbn A = kn), kbs = bond_shear_ratio kbn, lambda, the calibrated strength; `over` replaces fields.
 function M.bond(over)
   local b = {beam_kn = M.contact.kn, beam_ks = M.contact.kn * M.rev.bond_shear_ratio,
              radius_factor = M.rev.bond_radius_factor,
-             tensile_strength = M.rev.bond_tensile_strength}
+             tensile_strength = M.rev.bond_tensile_strength,
+             contact_strength = (M.contact_strength(M.rev.contact_strength))}
   for k, v in pairs(over or {}) do b[k] = v end
   if b.breakable == false then b.tensile_strength = nil end
   return b

@@ -30,4 +30,34 @@ assert(#w:break_events(w:break_count()) == 1, "break_events(first) starts at `fi
 assert(asperity.bond_criterion(st, 0, st) == 1 and asperity.bond_criterion(-10 * st, 0, st) >= 0.999)
 snaps:write(w)
 assert(io.open(out .. "/particles_bonds.xdmf"), "bonds XDMF written")
+
+-- Contact bonds apart from the beams (model.md 5): the same bar with c = 2 loses its first beam
+-- at st, holds on by the contact bond, which breaks at 2 st A; every kind counted on its own.
+local w2 = asperity.world{material = {kn = 1e3, ks = 1e2}, damping = 0.7, threads = 1}
+for i = 0, 5 do w2:add_particle({0.02 * i, 0, 0}, 0.01) end
+assert(w2:install_bonds{tensile_strength = st, contact_strength = 2} == 5)
+w2:add_group({1}, {velocity = {-0.01, 0, 0}})
+w2:add_group({6}, {velocity = {0.01, 0, 0}})
+w2:run{steps = 100000, every = 10, stop_when = function(w) return w:break_count() > 0 end}
+local beams = w2:break_count()  -- the bar's bonds carry the same force: several may go at once
+assert(beams >= 1 and w2:break_count("contact_bond") == 0 and w2:bond_count() == 5 - beams)
+local held = 0
+for _, bd in ipairs(w2:bonds()) do
+  if not bd.beam then
+    assert(bd.contact_bond and bd.normal_force < 0, "the contact bond alone pulls")
+    held = held + 1
+  end
+end
+assert(held == beams and #w2:bonds() == 5, "the broken beams' pairs are still tied")
+w2:run{steps = 100000, every = 10, stop_when = function(w) return w:break_count("contact_bond") > 0 end}
+local e = w2:break_events()[w2:break_count("all")]
+assert(e.kind == "contact_bond" and e.mode == "tension", e.kind .. " " .. e.mode)
+assert(e.sigma >= 2 * st and e.sigma < 2.05 * st, "the contact bond broke at -Fn / A = " .. e.sigma)
+assert(w2:break_count("all") == w2:break_count("beam") + w2:break_count("contact_bond"))
+assert(w2:break_events(1)[1].kind == "beam")
+local ok, err = pcall(w2.break_count, w2, "beams")
+assert(not ok and tostring(err):find('"beam", "contact_bond" or "all"'), tostring(err))
+ok, err = pcall(w2.set_bond_strength, w2, {tensile_strength = st, contact_strength = -1})
+assert(not ok and tostring(err):find("contact_strength"), tostring(err))
+w2:set_bond_strength{tensile_strength = st, contact_strength = math.huge}  -- never breaks from now on
 print("PASS")

@@ -40,11 +40,13 @@ local function broken_by_depth(run)
   local bins = math.max(1, math.ceil(run.P.thickness * 1e3))
   for k = 1, bins do lower_bins[k], upper_bins[k] = 0, 0 end
   for _, ev in ipairs(world:break_events()) do
+    if ev.kind ~= "beam" then goto next end  -- the parallel bonds (the thesis's broken bonds)
     local z = ev.position[3]
     local upper_side = world:tag(ev.a) == context.UPPER
     local depth = upper_side and (z - shift) or -z
     local k = math.max(1, math.min(bins, math.floor(depth * 1e3) + 1))
     if upper_side then upper_bins[k] = upper_bins[k] + 1 else lower_bins[k] = lower_bins[k] + 1 end
+    ::next::
   end
   local edges = {}
   for k = 1, bins do edges[k] = k end
@@ -102,7 +104,7 @@ local function plot_maps(run)
     local function broken_until(step)
       local pts = {}
       for _, ev in ipairs(events) do
-        if not step or ev.step <= step then pts[#pts + 1] = {ev.position[1], ev.position[2]} end
+        if ev.kind == "beam" and (not step or ev.step <= step) then pts[#pts + 1] = {ev.position[1], ev.position[2]} end
       end
       return pts
     end

@@ -57,16 +57,17 @@ local function normal_control(run)
 end
 
 -- Every bond break while shearing (model.md 5), for the event statistics and maps.
-local function write_breaks(run, breaks_before)
+local function write_breaks(run, events_before)
   local world = run.world
-  if world:break_count() <= breaks_before then return end
-  local breaks = asperity.series{"step [1]", "time [s]", "x [m]", "y [m]", "z [m]", "mode [1]", "sigma [Pa]",
-                                 "tau [Pa]", "released_energy [J]"}
+  if world:break_count("all") <= events_before then return end
+  local breaks = asperity.series{"step [1]", "time [s]", "x [m]", "y [m]", "z [m]", "kind [1]", "mode [1]",
+                                 "sigma [Pa]", "tau [Pa]", "released_energy [J]"}
+  breaks:set_attribute("kind", "1 parallel bond (beam), 2 contact bond")
   breaks:set_attribute("mode", "1 tension, 2 compression, 3 shear")
   local mode_code = {tension = 1, compression = 2, shear = 3}
-  for _, ev in ipairs(world:break_events(breaks_before + 1)) do
-    breaks:record(ev.step, ev.time, ev.position[1], ev.position[2], ev.position[3], mode_code[ev.mode] or 0,
-                  ev.sigma, ev.tau, ev.released_energy)
+  for _, ev in ipairs(world:break_events(events_before + 1)) do
+    breaks:record(ev.step, ev.time, ev.position[1], ev.position[2], ev.position[3], ev.kind == "beam" and 1 or 2,
+                  mode_code[ev.mode] or 0, ev.sigma, ev.tau, ev.released_energy)
   end
   breaks:write(run.P.out .. "/breaks")
 end
@@ -154,7 +155,7 @@ function M.run(run)
   -- Event statistics (scenarios.md 8): the energies every `events_every` steps while shearing, on the
   -- run's sample cadence (the records, the velocity ramp and the trajectory are those of a run
   -- without samples); the breaks themselves come from world:break_events.
-  local events, breaks_before = nil, world:break_count()
+  local events, breaks_before, events_before = nil, world:break_count(), world:break_count("all")
   if P.events_every > 0 then
     events = asperity.series{"step [1]", "displacement [mm]", "broken_bonds [1]", "kinetic [J]", "strain [J]",
                              "damping [J]", "friction [J]", "released [J]"}
@@ -232,7 +233,7 @@ function M.run(run)
   run:label_series(shear)
   shear:write(P.out .. "/shear")
   if events then events:write(P.out .. "/events") end
-  write_breaks(run, breaks_before)
+  write_breaks(run, events_before)
   run:log("sheared %.2f mm", run:displacement())
 end
 
