@@ -838,6 +838,12 @@ void World::set_friction(double mu) {
   // Only the slip limit [3-22] changes: a shear force above mu Fn slips at the next step.
   state_->settings.contact = m;
 }
+void World::set_rotation_lock_bonds(double k) {
+  check_setting("set_rotation_lock_bonds", "rotation_lock_bonds", k);
+  require(k == std::floor(k), "set_rotation_lock_bonds: rotation_lock_bonds must be a whole number, got " + num(k));
+  state_->settings.rotation_lock_bonds = int(k);
+  detail::refresh_bond_topology(*state_);  // the locks by the new rule
+}
 void World::set_overlap_limit(double r) {
   check_setting("set_overlap_limit", "overlap_limit", r);
   state_->settings.overlap_limit = r;

@@ -90,6 +90,8 @@ local P = params_lib.parse{
   {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "thesis definition [3-35]: the particle count of the genesis"},
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "isotropic stress installed before bonding (scenarios.md 1; model units)"},
   {"bond_gap", 0, unit = "m", min = 0, doc = "largest gap bonded (0: the engine's default, 1e-3 x mean radius)"},
+  {"rotation_lock_bonds", mat.rev.rotation_lock_bonds, type = "integer", min = 1,
+   doc = "fracture model: a damaged particle rotates once it holds fewer bonds (1: the thesis's rule; model.md 2)"},
   {"contact_strength", mat.rev.contact_strength, type = "string",
    doc = "fracture model: the contact bonds break at c st A: c > 0, \"inf\" (never) or \"beam\" (with the parallel bond) (model.md 5)"},
   {"wall_friction", 0, min = 0, doc = "of the box walls and the mould during the genesis (scenarios.md 1: frictionless)"},

@@ -262,6 +262,9 @@ std::span<const Function> world_run_methods() {
       {"set_dt_safety", set_world_number<&World::set_dt_safety>, "world:set_dt_safety(f)",
        "Automatic time step = f x the critical estimate (default 0.8; 0.001 <= f <= 2)."},
       {"set_skin", set_world_number<&World::set_skin>, "world:set_skin(m)", "Verlet skin in m (the list is rebuilt)."},
+      {"set_rotation_lock_bonds", set_world_number<&World::set_rotation_lock_bonds>, "world:set_rotation_lock_bonds(k)",
+       "A particle with a bond does not rotate; once one of its bonds broke, only while it holds k\n"
+       "(1: the thesis's rule, every bonded particle locked; model.md 2)."},
       {"set_overlap_limit", set_world_number<&World::set_overlap_limit>, "world:set_overlap_limit(r)",
        "The health check's deepest overlap, in radii of the smaller body (default 1; 0 < r < 2).\n"
        "Deeper, one centre is inside the other particle; a rigid block's contacts may go there."},

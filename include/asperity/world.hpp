@@ -438,6 +438,9 @@ class World {
   void set_dt_safety(double f);           // automatic dt = f x estimate (0 < f <= 2)
   void set_skin(double skin);             // Verlet skin, m (> 0); the list is rebuilt
   void set_overlap_limit(double r);       // health check's deepest overlap / smaller radius, (0, 2)
+  // The rotation lock's count rule (WorldSettings::rotation_lock_bonds; 1: the thesis's rule, a
+  // particle holding a bond does not rotate), applied at once.
+  void set_rotation_lock_bonds(double k);
   void set_friction(double mu);           // ball-ball Coulomb coefficient from now on (>= 0)
   double critical_dt();                   // estimate now [3-30..3-32], without safety factor
   std::uint64_t step_count() const;
