@@ -61,7 +61,8 @@ local P = params_lib.parse{
   {"density", mat.density, unit = "kg/m^3", above = 0, doc = "particle density"},
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "isotropic stress the genesis installs before bonding (model units)"},
   {"floater_contacts", mat.genesis.floater_contacts, type = "integer", min = 0,
-   doc = "particles with fewer contacts are taken out"},
+   doc = "particles with fewer contacts are floaters"},
+  {"grow_floaters", mat.genesis.grow_floaters, doc = "floaters get the radius that makes them touch floater_contacts (else they are taken out)"},
   {"tensile_strength", rev.bond_tensile_strength, unit = "Pa", above = 0,
    doc = "bond strength st of the elliptic criterion (model units; the calibrated one by default)"},
   {"bond_shear_ratio", rev.bond_shear_ratio, min = 0, doc = "kbs / kbn of the parallel bonds"},
@@ -131,7 +132,7 @@ local function make_packing()
                                      seed = P.seed, normalise_mean = true}
   local g = genesis.pack(w, {min = lo, max = hi, radii = r, seed = P.seed, box = box, stress = P.genesis_stress,
                              friction = P.friction, ratio = P.ratio, min_contacts = P.floater_contacts,
-                             log = log})
+                             grow_floaters = P.grow_floaters, log = log})
   local info = {n_particles = #g.kept, n_generated = n, genesis = g, box = box, kept = g.kept,
                 porosity_nominal = g.porosity_nominal, porosity_true = g.porosity_true,
                 mean_radius = g.mean_radius, coordination = g.coordination,
@@ -150,7 +151,7 @@ local function cached_packing()
   asperity.mkdir(P.cache)
   local key = ("rev_v3_L%.6g_n%.6g_s%d_r%.6g_%.6g_k%.6g_%.6g_d%.6g_%.6g_g%.6g_f%d_q%.6g"):format(P.size, P.porosity,
     P.seed, P.mean_radius, P.radius_sd, P.kn, P.ks, P.damping, P.density, P.genesis_stress, P.floater_contacts, P.ratio)
-    .. (P.lock_rotation and ("_l%d"):format(P.rotation_lock_bonds) or "_free")
+    .. (P.lock_rotation and ("_l%d"):format(P.rotation_lock_bonds) or "_free") .. (P.grow_floaters and "_grown" or "")
   local h5, rec = P.cache .. "/" .. key .. ".h5", P.cache .. "/" .. key .. ".lua"
   local f = io.open(rec, "r")
   if f then
@@ -232,9 +233,9 @@ local function residual_stresses(w)
   return stats
 end
 local residual = residual_stresses(welastic)
-log("bond stresses after wall removal: sigma %.3g .. %.3g Pa, strength to hold max %.3g Pa = %.3f st (p99 %.3g)",
-    residual.sigma_min_pa, residual.sigma_max_pa, residual.strength_to_hold_max_pa, residual.max_over_st,
-    residual.strength_to_hold_p99_pa)
+log("bond stresses after wall removal: sigma %.3g .. %.3g Pa, strength to hold: 99.9 %% below %.3g Pa = %.3f st, max %.3g Pa = %.3f st",
+    residual.sigma_min_pa, residual.sigma_max_pa, residual.strength_to_hold_p999_pa, residual.p999_over_st,
+    residual.strength_to_hold_max_pa, residual.max_over_st)
 
 -- 3. Platens and gauges -------------------------------------------------------------------------------
 local rigs = {}   -- checkpoint name -> {platens, gauges}
@@ -529,12 +530,13 @@ local summary = {
   radius_dispersion = packing.radius_stats.dispersion, coordination_packed = packing.coordination,
   wall_stress_pa = packing.wall_stress_pa,
   genesis = {particles_generated = packing.n_generated, floaters_removed = packing.genesis.floaters_removed,
+             floaters_grown = packing.genesis.floaters_grown, floater_share = packing.genesis.floater_share,
              stress_pa = packing.genesis.stress_pa, stress_target_pa = P.genesis_stress,
              stress_reached = packing.genesis.stress_reached, radius_factor = packing.genesis.radius_factor,
              coordination = packing.genesis.coordination, steps = packing.genesis.steps,
              seconds = packing.genesis.seconds, porosity_nominal = packing.porosity_nominal,
              porosity_true = packing.porosity_true},
-  bond_stress_max_over_st = residual.max_over_st,
+  bond_stress_max_over_st = residual.max_over_st, bond_stress_p999_over_st = residual.p999_over_st,
   bonds_above_third_of_st = residual.above_third_of_st,
   bonds = elastic_info.bonds, bonds_per_particle = 2 * elastic_info.bonds / packing.n_particles,
   residual_bond_stress = residual,

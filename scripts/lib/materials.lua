@@ -23,7 +23,7 @@ M.packing = {mean_radius = 0.5e-3, radius_sd = 0.1e-3, cut = 3, porosity = 0.51}
 -- `floater_contacts` contacts taken out. The stress is about 0.35 % of the REV's compressive
 -- strength; the bonds then need at most a third of st after the wall removal (the largest bond
 -- stress is about 8 times the mean stress, the tail of the contact forces).
-M.genesis = {porosity = 0.45, stress = 8e-4, floater_contacts = 3, ratio = 1e-2}
+M.genesis = {porosity = 0.45, stress = 8e-4, floater_contacts = 3, ratio = 1e-2, grow_floaters = false}
 
 -- Target rock, thesis Table 3-1 (mortar replicas of granite).
 M.rock = {young_modulus = 30853e6, poisson_ratio = 0.187, compressive_strength = 74.6e6,
