@@ -90,6 +90,8 @@ local P = params_lib.parse{
   {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "thesis definition [3-35]: the particle count of the genesis"},
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "isotropic stress installed before bonding (scenarios.md 1; model units)"},
   {"bond_gap", 0, unit = "m", min = 0, doc = "largest gap bonded (0: the engine's default, 1e-3 x mean radius)"},
+  {"tensile_strength", mat.rev.bond_tensile_strength, unit = "Pa", above = 0,
+   doc = "fracture model: bond strength st (model units; the REV's calibrated one by default)"},
   {"rotation_lock_bonds", mat.rev.rotation_lock_bonds, type = "integer", min = 1,
    doc = "fracture model: a damaged particle rotates once it holds fewer bonds (1: the thesis's rule; model.md 2)"},
   {"contact_strength", mat.rev.contact_strength, type = "string",

@@ -1,7 +1,8 @@
 -- The genesis (scripts/lib/genesis.lua, scenarios.md 1) on a small cube: the stress measured from
 -- the contacts matches the closed form on a lattice; the isotropic stress is installed within its
--- tolerance; floaters are taken out; the calibrated bonds hold what the wall removal leaves with
--- none above st / 3 and none broken.
+-- tolerance; floaters are taken out, or placed where they touch four neighbours (the tangent
+-- sphere against closed forms); the calibrated bonds hold what the wall removal leaves, 99.9 %
+-- of them below st / 3, none broken.
 local mat = require("materials")
 local radii = require("radii")
 local walls = require("walls")

@@ -54,7 +54,7 @@ end
 -- The cache file of the specimen, keyed by everything that shaped it.
 local function cache_file(P, s)
   local key = ("%s_%s_n%d_h%.6g_T%.6g_p%.4g_s%d_g%.6g_k%d_gs%.4g_fc%d_l%d_b%.4g_%.4g_gap%.4g"):format(
-    P.surface_file ~= "" and P.surface_file:gsub("[^%w]", "_") or P.surface, "v8", s.n, s.h, P.thickness,
+    P.surface_file ~= "" and P.surface_file:gsub("[^%w]", "_") or P.surface, mat.genesis.grow_floaters and "v9" or "v8", s.n, s.h, P.thickness,
     P.porosity, P.seed, P.gap, P.pack_steps, P.genesis_stress, mat.genesis.floater_contacts,
     mat.rev.rotation_lock_bonds, mat.rev.bond_shear_ratio, mat.rev.bond_radius_factor, P.bond_gap)
     .. (P.wall_friction ~= 0 and ("_f%.3g"):format(P.wall_friction) or "")
@@ -99,6 +99,7 @@ local function build(run)
   local g = genesis.pack(w, {min = lo, max = hi, radii = r, seed = P.seed, box = box, volume = volume,
                              stress = P.genesis_stress, friction = mat.contact.friction,
                              min_contacts = mat.genesis.floater_contacts, floater_tag = LOST,
+                             grow_floaters = mat.genesis.grow_floaters,
                              progress = P.progress, max_steps = P.pack_steps,
                              log = log,
                              split = function(x, y, z) return z < surface_z(x, y) and 1 or 2 end,
@@ -182,17 +183,19 @@ local function build(run)
       w:set_position(id, {p[1], p[2], p[3] + P.gap})
     end
   end})
-  log("%d particles left out (floaters %d; outside the box or without a bond %d)", g.floaters_removed + #lost,
-      g.floaters_removed, #lost)
+  log("%d particles left out (floaters without a place %d; outside the box or without a bond %d); %d floaters placed",
+      g.floaters_removed + #lost, g.floaters_removed, #lost, g.floaters_grown)
   w:save(run.cache_file)
   local record = {particles = w:particle_count(), lower = #lower, upper = #upper,
-    left_out = g.floaters_removed + #lost, floaters_removed = g.floaters_removed, bonds = b.bonds,
+    left_out = g.floaters_removed + #lost, floaters_removed = g.floaters_removed, floaters_grown = g.floaters_grown,
+    floater_share = g.floater_share, bonds = b.bonds,
     porosity_nominal = g.porosity_nominal, porosity_true = g.porosity_true, mean_radius = g.mean_radius,
     coordination = g.coordination, genesis_stress_pa = g.stress_pa, genesis_stress_target_pa = P.genesis_stress,
     genesis_stress_reached = g.stress_reached, radius_factor = g.radius_factor, genesis_steps = g.steps,
     genesis_seconds = g.seconds, relax_steps = b.relax_steps, relax_reached = b.relax_reached,
     bonds_broken_in_relaxation = b.broken_in_relaxation, bond_stress = b.bond_stress,
-    bond_stress_max_over_st = b.bond_stress_max_over_st, defined_state = b.defined_state,
+    bond_stress_max_over_st = b.bond_stress_max_over_st, bond_stress_p999_over_st = b.bond_stress_p999_over_st,
+    defined_state = b.defined_state,
     wall_stress_pa = g.wall_stress_pa}
   asperity.write_json(run.cache_file .. ".json", record)
   local f = assert(io.open(run.cache_file .. ".lua.tmp", "w"))
