@@ -32,6 +32,7 @@ local P = params_lib.parse{
   {"rotation_lock_bonds", mat.rev.rotation_lock_bonds, type = "integer", min = 1, doc = "passed to rev.lua"},
   {"bond_gap", 0, unit = "m", min = 0, doc = "passed to rev.lua"},
   {"contact_strength", mat.rev.contact_strength, type = "string", doc = "passed to rev.lua (c > 0, \"inf\" or \"beam\")"},
+  {"contact_shear_strength", mat.rev.contact_shear_strength, type = "string", doc = "passed to rev.lua (cs > 0, \"inf\" or \"same\")"},
   {"grow_floaters", mat.genesis.grow_floaters, doc = "passed to rev.lua"},
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "passed to rev.lua"},
   {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "passed to rev.lua"},
@@ -45,6 +46,8 @@ local P = params_lib.parse{
     end
     local _, why = mat.contact_strength(P.contact_strength)
     if why then fail("contact_strength", why) end
+    local _, why_shear = mat.contact_shear_strength(P.contact_shear_strength)
+    if why_shear then fail("contact_shear_strength", why_shear) end
   end,
 }
 if not P then return end   -- help printed
@@ -59,7 +62,8 @@ local function rev(st, tests, seed, name)
   params = {tensile_strength = st, tests = tests, seed = seed, cache = cache,
             bond_shear_ratio = P.bond_shear_ratio, bond_radius_factor = P.bond_radius_factor,
             rotation_lock_bonds = P.rotation_lock_bonds, bond_gap = P.bond_gap,
-            contact_strength = P.contact_strength, grow_floaters = P.grow_floaters,
+            contact_strength = P.contact_strength, contact_shear_strength = P.contact_shear_strength,
+            grow_floaters = P.grow_floaters,
             genesis_stress = P.genesis_stress, porosity = P.porosity,
             out = ("%s/%s_seed%d"):format(out, name, seed)}
   return dofile(rev_script)

@@ -96,6 +96,8 @@ local P = params_lib.parse{
    doc = "fracture model: a damaged particle rotates once it holds fewer bonds (1: the thesis's rule; model.md 2)"},
   {"contact_strength", mat.rev.contact_strength, type = "string",
    doc = "fracture model: the contact bonds break at c st A: c > 0, \"inf\" (never) or \"beam\" (with the parallel bond) (model.md 5)"},
+  {"contact_shear_strength", mat.rev.contact_shear_strength, type = "string",
+   doc = "fracture model: the contact bonds break in shear at cs st A: cs > 0, \"inf\" (never) or \"same\" (as contact_strength)"},
   {"wall_friction", 0, min = 0, doc = "of the box walls and the mould during the genesis (scenarios.md 1: frictionless)"},
   {"seed", 1, type = "integer", min = 0, doc = "of the surface and the packing"},
   {"pack_steps", 300000, type = "integer", min = 1, doc = "most steps spent cycling the packing towards the ratio 1e-4"},
@@ -127,6 +129,8 @@ local P = params_lib.parse{
     if P.record >= P.shear then fail("record", ("must be < shear (%g mm)"):format(P.shear)) end
     local _, why = mat.contact_strength(P.contact_strength)
     if why then fail("contact_strength", why) end
+    local _, why_shear = mat.contact_shear_strength(P.contact_shear_strength)
+    if why_shear then fail("contact_shear_strength", why_shear) end
     if P.ramp >= P.shear then fail("ramp", ("must be < shear (%g mm)"):format(P.shear)) end
     if P.speedup > 1 and P.model == "fracture" then
       fail("speedup", "is not for the fracture model: its results depend on the loading rate already at "

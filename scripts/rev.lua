@@ -69,6 +69,8 @@ local P = params_lib.parse{
   {"bond_radius_factor", rev.bond_radius_factor, above = 0, max = 1, doc = "lambda: Rb = lambda min(Ra, Rb) [3-26]"},
   {"contact_strength", rev.contact_strength, type = "string",
    doc = "the contact bonds break at c st A: c > 0, \"inf\" (never) or \"beam\" (with the parallel bond) (model.md 5)"},
+  {"contact_shear_strength", mat.rev.contact_shear_strength, type = "string",
+   doc = "the contact bonds break in shear at cs st A: cs > 0, \"inf\" (never) or \"same\" (as contact_strength)"},
   {"rate", 1e-6, unit = "m/s", above = 0, doc = "platen velocity (thesis: 1 um/s)"},
   {"elastic_strain", 2e-4, above = 0, below = 0.1, doc = "strain reached in the elastic tests"},
   {"stop_fraction", 0.7, above = 0, below = 1, doc = "fracture tests stop when |stress| < this x peak, after the peak"},
@@ -97,6 +99,8 @@ local P = params_lib.parse{
     if #params_lib.split(P.tests) == 0 then fail("tests", "must name at least one test") end
     local _, why = mat.contact_strength(P.contact_strength)
     if why then fail("contact_strength", why) end
+    local _, why_shear = mat.contact_shear_strength(P.contact_shear_strength)
+    if why_shear then fail("contact_shear_strength", why_shear) end
   end,
 }
 if not P then return end   -- help printed
@@ -203,7 +207,8 @@ local function bonded(material, csv, axis)
 end
 
 local bond_material = {beam_kn = P.kn, beam_ks = P.kn * P.bond_shear_ratio, radius_factor = P.bond_radius_factor,
-                       contact_strength = (mat.contact_strength(P.contact_strength))}
+                       contact_strength = (mat.contact_strength(P.contact_strength)),
+                       contact_shear_strength = (mat.contact_shear_strength(P.contact_shear_strength))}
 if P.bond_gap > 0 then bond_material.tolerance = P.bond_gap end   -- else the engine's 1e-3 <R>
 local function with(t, extra)
   local c = {}

@@ -30,12 +30,12 @@ struct BondParams {
 };
 
 // The contact bond's failure (model.md 5, PFC's contact bond): its tensile normal force (fn < 0)
-// or its shear force reaches Fc = c st A. Compression never breaks it. Per lane: 0 where it
-// holds, else 1 where the tension reached Fc, 2 where only the shear did.
+// reaches Fcn or its shear force Fcs (c st A both by default). Compression never breaks it. Per
+// lane: 0 where it holds, else 1 where the tension reached Fcn, 2 where only the shear did.
 template <class T>
-inline T contact_bond_failure(const T& fn, const T& fsx, const T& fsy, const T& fsz, const T& fc) {
-  const auto tension = fn <= -fc;
-  const auto shear = fsx * fsx + fsy * fsy + fsz * fsz >= fc * fc;
+inline T contact_bond_failure(const T& fn, const T& fsx, const T& fsy, const T& fsz, const T& fcn, const T& fcs) {
+  const auto tension = fn <= -fcn;
+  const auto shear = fsx * fsx + fsy * fsy + fsz * fsz >= fcs * fcs;
   return select(tension, T(1.0), select(shear, T(2.0), T(0.0)));
 }
 

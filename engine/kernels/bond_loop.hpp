@@ -19,7 +19,9 @@ BondSums bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) 
   const bool breakable = k.strength > 0;
   // The contact bond breaks with the beam (c = 0), never (c = inf) or at c st A (model.md 5).
   const bool with_beam = k.contact_strength == 0;
-  const bool contact_breaks = !with_beam && k.contact_strength < std::numeric_limits<double>::infinity();
+  const double shear_factor = k.contact_shear_strength > 0 ? k.contact_shear_strength : k.contact_strength;
+  constexpr double never = std::numeric_limits<double>::infinity();
+  const bool contact_breaks = !with_beam && (k.contact_strength < never || shear_factor < never);
   T count(0.0), slip(0.0);
   for (std::size_t i = begin; i < end; i += Lanes::size) {
     const BatchSides<T> q = load_sides<Lanes, Rotation>(k, i);
@@ -79,8 +81,9 @@ BondSums bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) 
       const auto beam_fails = beam_on & (crit >= T(1.0));
       T brk = select(beam_fails, T(with_beam ? kBothHold : kBeamHolds), T(0.0));
       if (contact_breaks) {
-        const T fc = T(k.contact_strength) * p.strength * (kPi * rsafe * rsafe);  // c st A
-        const T cf = contact_bond_failure(s.fn, s.fsx, s.fsy, s.fsz, fc);
+        const T st_area = p.strength * (kPi * rsafe * rsafe);  // st A
+        const T cf = contact_bond_failure(s.fn, s.fsx, s.fsy, s.fsz, T(k.contact_strength) * st_area,
+                                          T(shear_factor) * st_area);
         brk = brk + select(contact_on & (cf != T(0.0)), T(kContactBondHolds), T(0.0));
       }
       count = count + select(brk != T(0.0), T(1.0), T(0.0));

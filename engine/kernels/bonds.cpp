@@ -24,7 +24,7 @@ kernels::BondKernelArgs bond_kernel_args(State& s) {
           q.mbsz.data(), q.broken.data(), q.out.data(), m.kn, m.ks,
           bm.beam_kn, bm.beam_ks, s.dt, bm.breakable ? bm.tensile_strength : 0.0, p.capacity,
           s.rest_overlaps ? q.rest.data() : nullptr, s.cache.bonds_partial ? q.holds.data() : nullptr,
-          m.friction, bm.contact_strength};
+          m.friction, bm.contact_strength, bm.contact_shear_strength};
 }
 
 namespace {
@@ -283,7 +283,7 @@ void process_breaks(State& s) {
       ev.sigma = -q.fn[k] / A;
       ev.tau = fs / A;
       ev.mode = -q.fn[k] >= bm.contact_strength * bm.tensile_strength * A ? BreakEvent::Mode::tension
-                                                                          : BreakEvent::Mode::shear;
+                                                                          : BreakEvent::Mode::shear;  // as the kernel
       ev.kind = BreakEvent::Kind::contact_bond;
       book(kernels::spring_energy(q, k, m) - spring_kept);
     }

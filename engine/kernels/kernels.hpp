@@ -83,6 +83,7 @@ struct BondKernelArgs {
   // c of the contact bond's strength c st A (BondMaterial::contact_strength): 0 breaks it with
   // the beam, inf never.
   double contact_strength = 0;
+  double contact_shear_strength = 0;  // cs of its shear strength cs st A (0: cs = c)
 };
 
 struct BondSums {

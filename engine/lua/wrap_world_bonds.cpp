@@ -70,10 +70,11 @@ int world_set_bond_strength(lua_State* L) {
     const bool breakable = o.boolean("breakable", true);
     const auto st = o.number("tensile_strength");
     const auto c = o.number("contact_strength");
+    const auto cs = o.number("contact_shear_strength");
     o.finish();
     if (breakable && !st)
       throw Error("world:set_bond_strength: give tensile_strength = (Pa), or breakable = false");
-    w.set_bond_strength(st ? *st : 0.0, breakable, c);
+    w.set_bond_strength(st ? *st : 0.0, breakable, c, cs);
     return 0;
   });
 }
@@ -230,10 +231,11 @@ std::span<const Function> world_bond_methods() {
       {"bond_count", world_bond_count, "world:bond_count() -> n",
        "Parallel bonds that hold (a pair held by its contact bond alone is not counted)."},
       {"set_bond_strength", world_set_bond_strength,
-       "world:set_bond_strength{tensile_strength= | breakable=false [, contact_strength=]}",
+       "world:set_bond_strength{tensile_strength= | breakable=false [, contact_strength=]\n"
+       "  [, contact_shear_strength=]}",
        "Changes the strength of every bond (stiffness and stored forces unchanged); contact_strength\n"
-       "(c: the contact bond breaks at c st A; 0 with the beam, math.huge never) stays as it is\n"
-       "unless given."},
+       "(c: the contact bond breaks at c st A; 0 with the beam, math.huge never) and\n"
+       "contact_shear_strength (cs: in shear at cs st A; 0 as c) stay as they are unless given."},
       {"remove_bonds", world_remove_bonds, "world:remove_bonds()",
        "Deletes every bond (no break events; bonded pairs become ordinary contacts)."},
       {"save", world_save, "world:save(path)",

@@ -27,7 +27,8 @@ struct ContactMaterial {
 // beam by the elliptic criterion, the contact bond when its tensile normal force or its shear
 // force reaches c st A (PFC's contact bond, Fcn = Fcs = c st A, A the beam's area), where
 // c = contact_strength; c = inf: it never breaks; c = 0: it breaks with the beam (the pair
-// becomes an ordinary contact the step its beam breaks, and never breaks on its own).
+// becomes an ordinary contact the step its beam breaks, and never breaks on its own). The shear
+// strength may differ: Fcs = cs st A with cs = contact_shear_strength (0: cs = c).
 struct BondMaterial {
   double beam_kn = 0.1;            // kbn * A, N/m
   double beam_ks = 0.01;           // kbs * A, N/m
@@ -35,6 +36,7 @@ struct BondMaterial {
   double tensile_strength = 0.0;   // st, Pa (elliptic criterion [3-46..3-49])
   bool breakable = true;           // false: the elastic model (bonds never break)
   double contact_strength = 0.0;   // c: Fcn = Fcs = c st A; 0: breaks with the beam
+  double contact_shear_strength = 0.0;  // cs: Fcs = cs st A instead; 0: as contact_strength
   bool operator==(const BondMaterial&) const = default;
 };
 
@@ -69,6 +71,9 @@ void for_each_field(Material& m, Visit&& visit) {
   visit(Field{"contact_strength", "contact_strength", 9, {0, inf, true, false, "breaks with the beam"},
               "c: the contact bond breaks at a tensile or shear force c st A (model.md 5), inf never"},
         m.contact_strength);
+  visit(Field{"contact_shear_strength", "contact_shear_strength", 9, {0, inf, true, false, "as contact_strength"},
+              "cs: the contact bond's shear strength cs st A instead of c st A, inf never"},
+        m.contact_shear_strength);
 }
 
 }  // namespace asperity

@@ -209,7 +209,8 @@ end
 -- all those among its nearest neighbours the one nearest its old centre. Computed from the gaps,
 -- not grown in steps, so the material does not depend on how many rattlers a packing happens to
 -- have; touching without overlap, it carries no force until loaded. A floater whose cage holds
--- no such sphere within the packing's range of radii, or away from the region's other walls
+-- no such sphere within the packing's range of radii and within rmax of its old centre, or away
+-- from the region's other walls
 -- (`inside(x, y, z, r)`, e.g. a joint's mould), is taken out. Floaters are visited in id order,
 -- each seeing the ones placed before it. Returns the ids taken out, the ids kept (grown ones
 -- included) and the ids grown.
@@ -229,8 +230,9 @@ function M.grow_floaters(world, o)
     planes[#planes + 1] = {n[1], n[2], n[3], o.min[k]}
     planes[#planes + 1] = {-n[1], -n[2], -n[3], -o.max[k]}
   end
-  -- Cells of 3 rmax: every particle within a gap of 2 rmax of a centre is in the 27 cells around.
-  local h = 3 * rmax
+  -- Cells of 4 rmax: every particle within a gap of 2 rmax of a centre is in the 27 cells around,
+  -- also a floater placed before, which moved by up to rmax from the cell of its old centre.
+  local h = 4 * rmax
   local cells = {}
   local function key(i, j, k) return (i * 4096 + j) * 4096 + k end
   local function cell_of(x, y, z) return math.floor(x / h) + 2048, math.floor(y / h) + 2048, math.floor(z / h) + 2048 end
@@ -270,8 +272,9 @@ function M.grow_floaters(world, o)
       local best, bx, by, bz, br = math.huge
       local function consider(cx, cy, cz, cr)
         if cr < rmin or cr > rmax then return end
+        -- Within rmax of the old centre, so that every particle it could overlap is in `near`.
         local moved2 = (cx - x) ^ 2 + (cy - y) ^ 2 + (cz - z) ^ 2
-        if moved2 >= best then return end
+        if moved2 >= best or moved2 > rmax * rmax then return end
         local slack = 1e-9 * cr
         for _, q in ipairs(near) do
           if math.sqrt((q[1] - cx) ^ 2 + (q[2] - cy) ^ 2 + (q[3] - cz) ^ 2) - q[4] < cr - slack then return end

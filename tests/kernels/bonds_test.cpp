@@ -395,6 +395,44 @@ TEST(ContactBonds, ShearBreaksTheContactBondAtCStAAndLeavesFriction) {
   EXPECT_LT(std::fabs(e.balance_error(e0)), 1e-3 * (e.boundary_work - e0.boundary_work));
 }
 
+// With its own shear strength cs (contact_shear_strength), the contact bond breaks in shear at
+// cs st A instead; with cs = inf never, whatever the shear.
+TEST(ContactBonds, AShearStrengthOfItsOwn) {
+  const double st = 0.02, u0 = 1e-4 * kR, v = 1e-6;
+  for (const double cs : {2.5, std::numeric_limits<double>::infinity()}) {
+    WorldSettings ws;
+    ws.local_damping = 0;
+    World w(ws);
+    const auto a = w.add_particle({0, 0, 0}, kR);
+    const auto b = w.add_particle({0, 0, 2 * kR - u0}, kR);
+    BondMaterial bm;
+    bm.tensile_strength = st;
+    bm.contact_strength = 1.0;
+    bm.contact_shear_strength = cs;
+    bm.breakable = true;
+    bm.beam_ks = 1e-4;  // a soft beam in shear: it holds past 2.5 st A of contact shear
+    ASSERT_EQ(w.install_bonds(bm), 1u);
+    GroupMotion fixed;
+    fixed.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
+    w.add_group(std::vector<std::int64_t>{a}, fixed);
+    w.add_group(std::vector<std::int64_t>{b}, moving({v, 0, 0}));
+    w.set_dt(1e-4);
+    // Sheared to three times c st A of contact shear force (ks dx).
+    const std::uint64_t steps = std::uint64_t(3 * st * kArea / (0.01 * v * 1e-4));
+    while (w.break_events().empty() && w.step_count() < steps) w.cycle(1);
+    if (std::isinf(cs)) {
+      EXPECT_TRUE(w.break_events().empty()) << "cs = inf: no shear breaks it";
+    } else {
+      ASSERT_EQ(w.break_events().size(), 1u);
+      const BreakEvent& ev = w.break_events()[0];
+      EXPECT_EQ(ev.kind, BreakEvent::Kind::contact_bond);
+      EXPECT_EQ(ev.mode, BreakEvent::Mode::shear);
+      EXPECT_GE(ev.tau, cs * st);
+      EXPECT_LT(ev.tau, cs * st + 1.0001 * 0.01 * v * w.dt() / kArea);
+    }
+  }
+}
+
 // A checkpoint keeps what of each bond holds and the kind of each break: the loaded world goes
 // on bit for bit.
 TEST(ContactBonds, ACheckpointKeepsWhatHolds) {
@@ -748,6 +786,7 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
       args.holds = h[28].data();
       args.friction = 0.5;
       args.contact_strength = 2.0;
+      args.contact_shear_strength = 3.0;
     }
     // The gather's records (store/bonds.hpp): every slot written, the pads with 0; records of 8
     // (no moment) from the kernel without moments, whose slots beyond them stay untouched.

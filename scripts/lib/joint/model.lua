@@ -74,7 +74,8 @@ local function bonded(run)
              "stress into the halves than the REV's genesis (scenarios.md 1). Run model=elastic or " ..
              "rigid, or lower genesis_stress."):format(over, #all, 100 * over / #all, st, worst), 0)
     end
-    world:set_bond_strength{tensile_strength = st, contact_strength = (mat.contact_strength(P.contact_strength))}
+    world:set_bond_strength{tensile_strength = st, contact_strength = (mat.contact_strength(P.contact_strength)),
+                            contact_shear_strength = (mat.contact_shear_strength(P.contact_shear_strength))}
     world:set_rotation_lock_bonds(P.rotation_lock_bonds)
   end
   -- Platens: the layer of each outer face. With the shear box, the side faces' layers too: a half
