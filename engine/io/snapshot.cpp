@@ -73,9 +73,10 @@ Snapshot take_snapshot(const World& world, bool with_contacts, std::int64_t id_b
       }
     }
   }
-  if (world.bond_count() > 0) {
+  const std::vector<BondInfo> bonds = world.bonds();
+  if (!bonds.empty()) {
     s.has_bonds = true;
-    for (const BondInfo& b : world.bonds()) {
+    for (const BondInfo& b : bonds) {
       s.bond_index_a.push_back(static_cast<std::int32_t>(b.id_a));
       s.bond_index_b.push_back(static_cast<std::int32_t>(b.id_b));
       s.bond_id_a.push_back(b.id_a + id_base);
@@ -85,6 +86,7 @@ Snapshot take_snapshot(const World& world, bool with_contacts, std::int64_t id_b
       s.bond_sigma.push_back(b.sigma);
       s.bond_tau.push_back(b.tau);
       s.bond_gap.push_back(b.gap);
+      s.bond_holds.push_back((b.beam ? 1 : 0) + (b.contact_bond ? 2 : 0));
     }
   }
   return s;
@@ -153,10 +155,12 @@ void drop_particles(Snapshot& s, const std::vector<bool>& keep) {
       s.bond_sigma[to] = s.bond_sigma[from];
       s.bond_tau[to] = s.bond_tau[from];
       s.bond_gap[to] = s.bond_gap[from];
+      s.bond_holds[to] = s.bond_holds[from];
       for (int d = 0; d < 3; ++d) s.bond_shear_force[3 * to + d] = s.bond_shear_force[3 * from + d];
     });
     for (auto* v : {&s.bond_index_a, &s.bond_index_b}) v->resize(k);
     for (auto* v : {&s.bond_id_a, &s.bond_id_b}) v->resize(k);
+    s.bond_holds.resize(k);
     for (auto* v : {&s.bond_normal_force, &s.bond_sigma, &s.bond_tau, &s.bond_gap}) v->resize(k);
     s.bond_shear_force.resize(3 * k);
   }
@@ -225,6 +229,7 @@ void write_snapshot_hdf5(const std::filesystem::path& path, const Snapshot& s) {
       h5::write_doubles(g, "sigma", s.bond_sigma, 0, "Pa", name);
       h5::write_doubles(g, "tau", s.bond_tau, 0, "Pa", name);
       h5::write_doubles(g, "gap", s.bond_gap, 0, "m", name);
+      h5::write_int32(g, "holds", s.bond_holds, 0, "", name);
     }
     h5::write_image(f, file.temp_path(), name);
   }
@@ -389,6 +394,7 @@ void SnapshotSeries::write_xdmf() const {
       attribute(b, "normal_force", "Scalar", "Cell", data_item(f, "/bonds/normal_force", m, 0, "Float", 8));
       attribute(b, "sigma", "Scalar", "Cell", data_item(f, "/bonds/sigma", m, 0, "Float", 8));
       attribute(b, "tau", "Scalar", "Cell", data_item(f, "/bonds/tau", m, 0, "Float", 8));
+      attribute(b, "holds", "Scalar", "Cell", data_item(f, "/bonds/holds", m, 0, "Int", 4));
       attribute(b, "shear_force", "Vector", "Cell", data_item(f, "/bonds/shear_force", m, 3, "Float", 8));
       b << "   </Grid>\n";
     }

@@ -167,6 +167,7 @@ struct Snapshot {
   std::vector<std::int64_t> bond_id_a, bond_id_b;
   std::vector<std::int32_t> bond_index_a, bond_index_b;
   std::vector<double> bond_normal_force, bond_shear_force, bond_sigma, bond_tau, bond_gap;
+  std::vector<std::int32_t> bond_holds;  // 1 the beam, 2 the contact bond, 3 both (model.md 5)
   Attributes attributes;
   Attributes particle_attributes;  // on /particles (the keys of group and tag)
   // The XDMF time of this snapshot when the series is indexed by something other than the

@@ -14,6 +14,8 @@ local first = snaps:write(w)
 local pair = asperity.read_h5(first, "/bonds/pair")
 assert(#pair == 5 and pair[1][1] == 0 and pair[1][2] == 1, "bond pairs are particle rows (from 0)")
 assert(asperity.h5_attribute(first, "/bonds/sigma", "units") == "Pa")
+local holds = asperity.read_h5(first, "/bonds/holds")
+assert(#holds == 5 and holds[1] == 3, "each bond says which part holds: both")
 
 w:add_group({1}, {velocity = {-0.01, 0, 0}})
 w:add_group({6}, {velocity = {0.01, 0, 0}})
