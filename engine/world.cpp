@@ -538,7 +538,10 @@ Vec3 World::group_velocity(int group) const { return state_->groups[check_group(
 double World::group_mass(int group) const { return state_->groups[check_group(*state_, group)].mass; }
 std::vector<std::int64_t> World::group_members(int group) const {
   std::vector<std::int64_t> out;
-  for (auto i : state_->groups[check_group(*state_, group)].members) out.push_back(state_->p.id[i]);
+  const detail::Group& g = state_->groups[check_group(*state_, group)];
+  // Every member, the inert ones too (they move with the group, only lazily).
+  for (const auto* list : {&g.members, &g.inert})
+    for (auto i : *list) out.push_back(state_->p.id[i]);
   std::sort(out.begin(), out.end());
   return out;
 }

@@ -92,7 +92,10 @@ int l_write_json(lua_State* L) {
 int l_json(lua_State* L) {
   return guarded(L, [&] {
     if (lua_isnone(L, 1)) throw ArgError{1, "value expected"};
-    std::string text = io::to_json_text(to_json(L, 1, 0, "value"), static_cast<int>(opt_integer(L, 2, 2)));
+    // Bounded: an indent is repeated at every level, and 1e6 on a table 60 deep asks for gigabytes.
+    const lua_Integer indent = opt_integer(L, 2, 2);
+    if (indent < 0 || indent > 16) throw ArgError{2, "indent must be 0..16 spaces, got " + std::to_string(indent)};
+    std::string text = io::to_json_text(to_json(L, 1, 0, "value"), static_cast<int>(indent));
     lua_pushlstring(L, text.data(), text.size());
     return 1;
   });

@@ -36,6 +36,10 @@ local cycle = {}
 cycle.self = cycle
 refuses("nesting deeper than 64", asperity.json, cycle)
 refuses("nesting deeper than 64", asperity.write_json, P.out .. "/cycle.json", cycle)
+-- An indent is repeated at every level: a huge one is refused by name, not allocated.
+refuses("indent must be 0..16", asperity.json, deep, 1e6)
+refuses("indent must be 0..16", asperity.json, deep, -1)
+assert(asperity.json({1}, 0) == "[1]" or asperity.json({1}, 0):find("1"), "indent 0 is accepted")
 
 -- Arrays whose rows x cols overflow.
 refuses("rows 4611686018427387904 outside", asperity.array, 2^62, 2)
