@@ -43,7 +43,7 @@ local P = params_lib.parse{
    doc = "reference surface (surfaces.md table 4), or flat: a plane, the control case"},
   {"surface_file", "", file = true, doc = "an HDF5 height map instead (dataset `height`, attribute `spacing`)"},
   {"scale", "", oneof = {"", "thesis"}, doc = "thesis: size 0.1 m (about 110 000 particles) unless size is given"},
-  {"size", 0.02, unit = "m", min = 4 * R, doc = "side of the square joint"},
+  {"size", 0.05, unit = "m", min = 4 * R, doc = "side of the square joint (scenarios.md 3: 5 cm; 2 cm is a fast check of the machinery)"},
   {"thickness", 0.006, unit = "m", min = 2 * R, doc = "each half beyond the mean plane"},
   {"spacing", 0.1 / 365, unit = "m", above = 0, doc = "surface grid spacing (the thesis grid)"},
   {"model", "elastic", oneof = {"rigid", "elastic", "fracture"},
