@@ -59,25 +59,28 @@ M.rev = {
                  strength_ratio = {mean = 11.984, sd = 0.448}},
 }
 
--- The contact bond's strength factor as a script gives it ("beam", "inf" or a number > 0) ->
--- the number the engine takes (BondMaterial::contact_strength: 0 breaks with the beam,
--- math.huge never); nil and what is allowed for anything else.
-function M.contact_strength(text)
-  if text == "beam" then return 0 end
+-- A contact-bond strength factor as a script gives it -> the number the engine takes: `word`
+-- (its 0), "inf" (math.huge: never breaks) or a number > 0; nil and what is allowed otherwise.
+local function strength_factor(text, word, allowed)
+  if text == word then return 0 end
   if text == "inf" then return math.huge end
   local c = tonumber(text)
   if c and c > 0 and c < math.huge then return c end
-  return nil, "must be \"beam\" (breaks with the parallel bond), \"inf\" (never breaks) or a number > 0 (c of c st A)"
+  return nil, allowed
 end
 
--- The contact bond's shear strength factor as a script gives it ("same", "inf" or a number > 0)
--- -> the engine's BondMaterial::contact_shear_strength (0: as contact_strength).
+-- c of the contact bond (BondMaterial::contact_strength): "beam" (0: breaks with the beam),
+-- "inf" or a number > 0.
+function M.contact_strength(text)
+  return strength_factor(text, "beam", "must be \"beam\" (breaks with the parallel bond), \"inf\" (never breaks) " ..
+                                       "or a number > 0 (c of c st A)")
+end
+
+-- cs of its shear strength (BondMaterial::contact_shear_strength): "same" (0: as c), "inf" or a
+-- number > 0.
 function M.contact_shear_strength(text)
-  if text == "same" then return 0 end
-  if text == "inf" then return math.huge end
-  local c = tonumber(text)
-  if c and c > 0 and c < math.huge then return c end
-  return nil, "must be \"same\" (as contact_strength), \"inf\" (never breaks in shear) or a number > 0 (cs of cs st A)"
+  return strength_factor(text, "same", "must be \"same\" (as contact_strength), \"inf\" (never breaks in shear) " ..
+                                       "or a number > 0 (cs of cs st A)")
 end
 
 -- Bond material for world:install_bonds: beams as stiff in tension as the contact springs

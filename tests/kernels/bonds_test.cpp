@@ -262,6 +262,23 @@ std::size_t breaks_of(const World& w, BreakEvent::Kind kind) {
                                    [&](const BreakEvent& e) { return e.kind == kind; }));
 }
 
+// Two spheres pressed u0 into each other along z and bonded there (the contact bond keeps the
+// compression kn u0, the beam starts at zero); a held, b driven along x at v, dt 1e-4 s.
+World pressed_pair(const BondMaterial& bm, double u0, double v) {
+  WorldSettings ws;
+  ws.local_damping = 0;
+  World w(ws);
+  const auto a = w.add_particle({0, 0, 0}, kR);
+  const auto b = w.add_particle({0, 0, 2 * kR - u0}, kR);
+  EXPECT_EQ(w.install_bonds(bm), 1u);
+  GroupMotion fixed;
+  fixed.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
+  w.add_group(std::vector<std::int64_t>{a}, fixed);
+  w.add_group(std::vector<std::int64_t>{b}, moving({v, 0, 0}));
+  w.set_dt(1e-4);
+  return w;
+}
+
 // Pulled apart: the beam breaks at sigma = st (its force beam_kn delta = st A), the contact bond
 // then holds alone, in tension, to kn delta = c st A; each break releases its own part's energy.
 TEST(ContactBonds, PulledApartTheBeamBreaksAtStAndTheContactBondAtCStA) {
@@ -353,20 +370,10 @@ TEST(ContactBonds, CompressionNeverBreaksAContactBond) {
 // contact, their shear force capped at mu Fn, the slip dissipated booked as friction.
 TEST(ContactBonds, ShearBreaksTheContactBondAtCStAAndLeavesFriction) {
   const double st = 0.02, c = 1.0, u0 = 1e-4 * kR, v = 1e-6;
-  WorldSettings ws;
-  ws.local_damping = 0;
-  World w(ws);
-  const auto a = w.add_particle({0, 0, 0}, kR);
-  const auto b = w.add_particle({0, 0, 2 * kR - u0}, kR);
   BondMaterial bm;
   bm.tensile_strength = st;
   bm.contact_strength = c;
-  ASSERT_EQ(w.install_bonds(bm), 1u);
-  GroupMotion fixed;
-  fixed.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
-  w.add_group(std::vector<std::int64_t>{a}, fixed);
-  w.add_group(std::vector<std::int64_t>{b}, moving({v, 0, 0}));
-  w.set_dt(1e-4);
+  World w = pressed_pair(bm, u0, v);
   const Energies e0 = w.energies();
   while (w.break_events().empty() && w.step_count() < 1000000) w.cycle(1);
   ASSERT_EQ(w.break_events().size(), 1u);
@@ -400,23 +407,12 @@ TEST(ContactBonds, ShearBreaksTheContactBondAtCStAAndLeavesFriction) {
 TEST(ContactBonds, AShearStrengthOfItsOwn) {
   const double st = 0.02, u0 = 1e-4 * kR, v = 1e-6;
   for (const double cs : {2.5, std::numeric_limits<double>::infinity()}) {
-    WorldSettings ws;
-    ws.local_damping = 0;
-    World w(ws);
-    const auto a = w.add_particle({0, 0, 0}, kR);
-    const auto b = w.add_particle({0, 0, 2 * kR - u0}, kR);
     BondMaterial bm;
     bm.tensile_strength = st;
     bm.contact_strength = 1.0;
     bm.contact_shear_strength = cs;
-    bm.breakable = true;
     bm.beam_ks = 1e-4;  // a soft beam in shear: it holds past 2.5 st A of contact shear
-    ASSERT_EQ(w.install_bonds(bm), 1u);
-    GroupMotion fixed;
-    fixed.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
-    w.add_group(std::vector<std::int64_t>{a}, fixed);
-    w.add_group(std::vector<std::int64_t>{b}, moving({v, 0, 0}));
-    w.set_dt(1e-4);
+    World w = pressed_pair(bm, u0, v);
     // Sheared to three times c st A of contact shear force (ks dx).
     const std::uint64_t steps = std::uint64_t(3 * st * kArea / (0.01 * v * 1e-4));
     while (w.break_events().empty() && w.step_count() < steps) w.cycle(1);

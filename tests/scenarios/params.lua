@@ -127,6 +127,10 @@ end
 
 -- Rules between parameters and the cases a user met.
 expect_refusal("joint.lua", {stress = -5}, "stress", "must be > 0")
+expect_refusal("joint.lua", {contact_strength = "strong"}, "contact_strength", 'must be "beam"')
+expect_refusal("joint.lua", {contact_strength = "0"}, "contact_strength", "a number > 0")
+expect_refusal("rev.lua", {contact_shear_strength = "-1"}, "contact_shear_strength", 'must be "same"')
+expect_refusal("calibrate_rev.lua", {contact_strength = "never"}, "contact_strength", '"inf"')
 expect_refusal("joint.lua", {stress = 0}, "stress", "must be > 0")
 expect_refusal("joint.lua", {shear = -1}, "shear")
 expect_refusal("joint.lua", {shear = 0}, "shear")
