@@ -671,7 +671,8 @@ std::size_t World::bond_count() const {
 }
 
 void World::set_bond_strength(double tensile_strength, bool breakable, std::optional<double> contact_strength,
-                              std::optional<double> contact_shear_strength) {
+                              std::optional<double> contact_shear_strength,
+                              std::optional<double> contact_bond_friction) {
   require(!breakable || (tensile_strength > 0 && std::isfinite(tensile_strength)),
           "set_bond_strength: a breakable bond needs tensile_strength > 0 (Pa), got " +
               num(tensile_strength));
@@ -680,6 +681,7 @@ void World::set_bond_strength(double tensile_strength, bool breakable, std::opti
   m.breakable = breakable;
   if (contact_strength) m.contact_strength = *contact_strength;
   if (contact_shear_strength) m.contact_shear_strength = *contact_shear_strength;
+  if (contact_bond_friction) m.contact_bond_friction = *contact_bond_friction;
   check_value("set_bond_strength: ", Field{"bond material"}, m);
   for (detail::BondStore* q : {&state_->bonds, &state_->frozen_bonds}) q->material = m;
 }

@@ -33,6 +33,7 @@ local P = params_lib.parse{
   {"bond_gap", 0, unit = "m", min = 0, doc = "passed to rev.lua"},
   {"contact_strength", mat.rev.contact_strength, type = "string", doc = "passed to rev.lua (c > 0, \"inf\" or \"beam\")"},
   {"contact_shear_strength", mat.rev.contact_shear_strength, type = "string", doc = "passed to rev.lua (cs > 0, \"inf\" or \"same\")"},
+  {"contact_bond_friction", mat.rev.contact_bond_friction, min = 0, doc = "passed to rev.lua"},
   {"grow_floaters", mat.genesis.grow_floaters, doc = "passed to rev.lua"},
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "passed to rev.lua"},
   {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "passed to rev.lua"},
@@ -63,6 +64,7 @@ local function rev(st, tests, seed, name)
             bond_shear_ratio = P.bond_shear_ratio, bond_radius_factor = P.bond_radius_factor,
             rotation_lock_bonds = P.rotation_lock_bonds, bond_gap = P.bond_gap,
             contact_strength = P.contact_strength, contact_shear_strength = P.contact_shear_strength,
+            contact_bond_friction = P.contact_bond_friction,
             grow_floaters = P.grow_floaters,
             genesis_stress = P.genesis_stress, porosity = P.porosity,
             out = ("%s/%s_seed%d"):format(out, name, seed)}

@@ -98,6 +98,8 @@ local P = params_lib.parse{
    doc = "fracture model: the contact bonds break at c st A: c > 0, \"inf\" (never) or \"beam\" (with the parallel bond) (model.md 5)"},
   {"contact_shear_strength", mat.rev.contact_shear_strength, type = "string",
    doc = "fracture model: the contact bonds break in shear at cs st A: cs > 0, \"inf\" (never) or \"same\" (as contact_strength)"},
+  {"contact_bond_friction", mat.rev.contact_bond_friction, min = 0,
+   doc = "fracture model: the contact bonds' shear strength grows by this x their compressive force (Mohr-Coulomb; 0: model.md 5)"},
   {"wall_friction", 0, min = 0, doc = "of the box walls and the mould during the genesis (scenarios.md 1: frictionless)"},
   {"seed", 1, type = "integer", min = 0, doc = "of the surface and the packing"},
   {"pack_steps", 300000, type = "integer", min = 1, doc = "most steps spent cycling the packing towards the ratio 1e-4"},

@@ -71,6 +71,8 @@ local P = params_lib.parse{
    doc = "the contact bonds break at c st A: c > 0, \"inf\" (never) or \"beam\" (with the parallel bond) (model.md 5)"},
   {"contact_shear_strength", mat.rev.contact_shear_strength, type = "string",
    doc = "the contact bonds break in shear at cs st A: cs > 0, \"inf\" (never) or \"same\" (as contact_strength)"},
+  {"contact_bond_friction", mat.rev.contact_bond_friction, min = 0,
+   doc = "the contact bonds' shear strength grows by this x their compressive force (Mohr-Coulomb; 0: model.md 5)"},
   {"rate", 1e-6, unit = "m/s", above = 0, doc = "platen velocity (thesis: 1 um/s)"},
   {"elastic_strain", 2e-4, above = 0, below = 0.1, doc = "strain reached in the elastic tests"},
   {"stop_fraction", 0.7, above = 0, below = 1, doc = "fracture tests stop when |stress| < this x peak, after the peak"},
@@ -208,7 +210,8 @@ end
 
 local bond_material = {beam_kn = P.kn, beam_ks = P.kn * P.bond_shear_ratio, radius_factor = P.bond_radius_factor,
                        contact_strength = (mat.contact_strength(P.contact_strength)),
-                       contact_shear_strength = (mat.contact_shear_strength(P.contact_shear_strength))}
+                       contact_shear_strength = (mat.contact_shear_strength(P.contact_shear_strength)),
+                       contact_bond_friction = P.contact_bond_friction}
 if P.bond_gap > 0 then bond_material.tolerance = P.bond_gap end   -- else the engine's 1e-3 <R>
 local function with(t, extra)
   local c = {}

@@ -24,7 +24,7 @@ kernels::BondKernelArgs bond_kernel_args(State& s) {
           q.mbsz.data(), q.broken.data(), q.out.data(), m.kn, m.ks,
           bm.beam_kn, bm.beam_ks, s.dt, bm.breakable ? bm.tensile_strength : 0.0, p.capacity,
           s.rest_overlaps ? q.rest.data() : nullptr, s.cache.bonds_partial ? q.holds.data() : nullptr,
-          m.friction, bm.contact_strength, bm.contact_shear_strength};
+          m.friction, bm.contact_strength, bm.contact_shear_strength, bm.contact_bond_friction};
 }
 
 namespace {

@@ -84,6 +84,7 @@ struct BondKernelArgs {
   // the beam, inf never.
   double contact_strength = 0;
   double contact_shear_strength = 0;  // cs of its shear strength cs st A (0: cs = c)
+  double contact_bond_friction = 0;   // mu_b: + mu_b Fn under compression
 };
 
 struct BondSums {

@@ -71,10 +71,11 @@ int world_set_bond_strength(lua_State* L) {
     const auto st = o.number("tensile_strength");
     const auto c = o.number("contact_strength");
     const auto cs = o.number("contact_shear_strength");
+    const auto mub = o.number("contact_bond_friction");
     o.finish();
     if (breakable && !st)
       throw Error("world:set_bond_strength: give tensile_strength = (Pa), or breakable = false");
-    w.set_bond_strength(st ? *st : 0.0, breakable, c, cs);
+    w.set_bond_strength(st ? *st : 0.0, breakable, c, cs, mub);
     return 0;
   });
 }
@@ -232,10 +233,11 @@ std::span<const Function> world_bond_methods() {
        "Parallel bonds that hold (a pair held by its contact bond alone is not counted)."},
       {"set_bond_strength", world_set_bond_strength,
        "world:set_bond_strength{tensile_strength= | breakable=false [, contact_strength=]\n"
-       "  [, contact_shear_strength=]}",
+       "  [, contact_shear_strength=] [, contact_bond_friction=]}",
        "Changes the strength of every bond (stiffness and stored forces unchanged); contact_strength\n"
        "(c: the contact bond breaks at c st A; 0 with the beam, math.huge never) and\n"
-       "contact_shear_strength (cs: in shear at cs st A; 0 as c) stay as they are unless given."},
+       "contact_shear_strength (cs: in shear at cs st A; 0 as c) and contact_bond_friction (mu_b:\n"
+       "+ mu_b Fn under compression) stay as they are unless given."},
       {"remove_bonds", world_remove_bonds, "world:remove_bonds()",
        "Deletes every bond (no break events; bonded pairs become ordinary contacts)."},
       {"save", world_save, "world:save(path)",

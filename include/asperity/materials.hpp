@@ -28,7 +28,9 @@ struct ContactMaterial {
 // force reaches c st A (PFC's contact bond, Fcn = Fcs = c st A, A the beam's area), where
 // c = contact_strength; c = inf: it never breaks; c = 0: it breaks with the beam (the pair
 // becomes an ordinary contact the step its beam breaks, and never breaks on its own). The shear
-// strength may differ: Fcs = cs st A with cs = contact_shear_strength (0: cs = c).
+// strength may differ: Fcs = cs st A with cs = contact_shear_strength (0: cs = c), and may grow
+// with the compression the contact bond carries, Mohr-Coulomb fashion: Fcs = cs st A + mu_b Fn
+// for Fn > 0 (mu_b = contact_bond_friction; 0, the default, is model.md 5's contact bond).
 struct BondMaterial {
   double beam_kn = 0.1;            // kbn * A, N/m
   double beam_ks = 0.01;           // kbs * A, N/m
@@ -37,6 +39,7 @@ struct BondMaterial {
   bool breakable = true;           // false: the elastic model (bonds never break)
   double contact_strength = 0.0;   // c: Fcn = Fcs = c st A; 0: breaks with the beam
   double contact_shear_strength = 0.0;  // cs: Fcs = cs st A instead; 0: as contact_strength
+  double contact_bond_friction = 0.0;   // mu_b: Fcs grows by mu_b Fn under compression
   bool operator==(const BondMaterial&) const = default;
 };
 
@@ -74,6 +77,9 @@ void for_each_field(Material& m, Visit&& visit) {
   visit(Field{"contact_shear_strength", "contact_shear_strength", 9, {0, inf, true, false, "as contact_strength"},
               "cs: the contact bond's shear strength cs st A instead of c st A, inf never"},
         m.contact_shear_strength);
+  visit(Field{"contact_bond_friction", "contact_bond_friction", 9, {0, inf, false, true},
+              "mu_b: the contact bond's shear strength grows by mu_b Fn under compression Fn > 0"},
+        m.contact_bond_friction);
 }
 
 }  // namespace asperity

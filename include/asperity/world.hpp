@@ -416,11 +416,12 @@ class World {
   std::size_t bond_count() const;                   // parallel bonds that hold
   // Change the strength of every bond (e.g. unbreakable while a specimen is prepared, then the
   // calibrated strength for the fracture model), and, where given, the contact bond's strength
-  // factors c and cs (BondMaterial::contact_strength, contact_shear_strength). Stiffness and
+  // factors c and cs and its friction mu_b (BondMaterial). Stiffness and
   // stored forces are unchanged.
   void set_bond_strength(double tensile_strength, bool breakable,
                          std::optional<double> contact_strength = std::nullopt,
-                         std::optional<double> contact_shear_strength = std::nullopt);
+                         std::optional<double> contact_shear_strength = std::nullopt,
+                         std::optional<double> contact_bond_friction = std::nullopt);
   void remove_bonds();                              // all of them (no events, no energy booked)
   std::vector<BondInfo> bonds() const;
   const std::vector<BreakEvent>& break_events() const;

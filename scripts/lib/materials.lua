@@ -51,6 +51,8 @@ M.rev = {
   contact_strength = "1.5",
   -- Its shear strength factor, if not c ("same"): "inf" never, a number > 0 at cs st A.
   contact_shear_strength = "same",
+  -- Its shear strength grows by mu_b Fn under compression Fn (0: model.md 5's contact bond).
+  contact_bond_friction = 0,
   calibration = {seeds = {1, 2, 3, 4, 5},
                  young_modulus_pa = {mean = 106.69, sd = 3.136},
                  poisson_ratio = {mean = 0.18143, sd = 0.00752},
@@ -90,7 +92,8 @@ function M.bond(over)
              radius_factor = M.rev.bond_radius_factor,
              tensile_strength = M.rev.bond_tensile_strength,
              contact_strength = (M.contact_strength(M.rev.contact_strength)),
-             contact_shear_strength = (M.contact_shear_strength(M.rev.contact_shear_strength))}
+             contact_shear_strength = (M.contact_shear_strength(M.rev.contact_shear_strength)),
+             contact_bond_friction = M.rev.contact_bond_friction}
   for k, v in pairs(over or {}) do b[k] = v end
   if b.breakable == false then b.tensile_strength = nil end
   return b

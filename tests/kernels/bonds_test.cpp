@@ -429,6 +429,30 @@ TEST(ContactBonds, AShearStrengthOfItsOwn) {
   }
 }
 
+// With a friction mu_b, the contact bond's shear strength grows with the compression it carries:
+// Fcs = cs st A + mu_b Fn (Mohr-Coulomb), Fn = kn u0 here.
+TEST(ContactBonds, CompressionRaisesTheShearStrengthByItsFriction) {
+  const double st = 0.02, u0 = 1e-3 * kR, v = 1e-6, mu_b = 0.5;
+  BondMaterial bm;
+  bm.tensile_strength = st;
+  bm.contact_strength = 1.0;
+  bm.contact_bond_friction = mu_b;
+  bm.beam_ks = 1e-4;  // a soft beam in shear: it holds
+  World w = pressed_pair(bm, u0, v);
+  while (w.break_events().empty() && w.step_count() < 1000000) w.cycle(1);
+  ASSERT_EQ(w.break_events().size(), 1u);
+  const BreakEvent& ev = w.break_events()[0];
+  EXPECT_EQ(ev.kind, BreakEvent::Kind::contact_bond);
+  EXPECT_EQ(ev.mode, BreakEvent::Mode::shear);
+  const double fn = -ev.sigma * kArea;  // the contact bond's normal force at the break (> 0)
+  // Still pressed, by a little less than kn u0: sliding b by dx stretches the pair by dx^2 / 2d.
+  EXPECT_GT(fn, 0.95 * 0.1 * u0);
+  EXPECT_LT(fn, 0.1 * u0);
+  const double strength = st * kArea + mu_b * fn;
+  EXPECT_GE(ev.tau * kArea, strength);
+  EXPECT_LT(ev.tau * kArea, strength + 1.0001 * 0.01 * v * w.dt());
+}
+
 // A checkpoint keeps what of each bond holds and the kind of each break: the loaded world goes
 // on bit for bit.
 TEST(ContactBonds, ACheckpointKeepsWhatHolds) {
@@ -783,6 +807,7 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
       args.friction = 0.5;
       args.contact_strength = 2.0;
       args.contact_shear_strength = 3.0;
+      args.contact_bond_friction = 0.3;
     }
     // The gather's records (store/bonds.hpp): every slot written, the pads with 0; records of 8
     // (no moment) from the kernel without moments, whose slots beyond them stay untouched.

@@ -75,7 +75,8 @@ local function bonded(run)
              "rigid, or lower genesis_stress."):format(over, #all, 100 * over / #all, st, worst), 0)
     end
     world:set_bond_strength{tensile_strength = st, contact_strength = (mat.contact_strength(P.contact_strength)),
-                            contact_shear_strength = (mat.contact_shear_strength(P.contact_shear_strength))}
+                            contact_shear_strength = (mat.contact_shear_strength(P.contact_shear_strength)),
+                            contact_bond_friction = P.contact_bond_friction}
     world:set_rotation_lock_bonds(P.rotation_lock_bonds)
   end
   -- Platens: the layer of each outer face. With the shear box, the side faces' layers too: a half
