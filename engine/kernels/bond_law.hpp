@@ -26,7 +26,6 @@ template <class T>
 struct BondParams {
   T kn, ks, beam_kn, beam_ks, dt;
   T strength;   // st; 0 or less: unbreakable
-  T friction;   // of the contact springs once their contact bond broke
 };
 
 // The contact bond's failure (model.md 5, PFC's contact bond): its tensile normal force (fn < 0)

@@ -14,8 +14,8 @@ namespace asperity::kernels {
 template <class Lanes, bool Rotation, bool Moments = true>
 BondSums bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
   using T = typename Lanes::Real;
-  const BondParams<T> p{T(k.kn), T(k.ks), T(k.beam_kn), T(k.beam_ks), T(k.dt), T(k.strength), T(k.friction)};
-  const LawParams<T> contact{T(k.kn), T(k.ks), T(k.friction), T(k.dt)};
+  const BondParams<T> p{T(k.kn), T(k.ks), T(k.beam_kn), T(k.beam_ks), T(k.dt), T(k.strength)};
+  const LawParams<T> contact{T(k.kn), T(k.ks), T(k.friction), T(k.dt)};  // once the contact bond broke
   const bool breakable = k.strength > 0;
   // The contact bond breaks with the beam (c = 0), never (c = inf) or at c st A (model.md 5).
   const bool with_beam = k.contact_strength == 0;
