@@ -52,25 +52,28 @@ function M.contact_counts(world)
   return counts
 end
 
+-- A hash grid of cubic cells of edge h: key(i, j, k) of a cell, cell_of(x, y, z) -> i, j, k.
+local function cell_grid(h)
+  local function key(i, j, k) return (i * 4096 + j) * 4096 + k end
+  local function cell_of(x, y, z) return math.floor(x / h) + 2048, math.floor(y / h) + 2048, math.floor(z / h) + 2048 end
+  return key, cell_of
+end
+
 -- Ball-ball contacts (overlap > 0) per particle among `ids`, from positions and radii.
 function M.touching_counts(world, ids)
   local pos, rad = world:positions(), world:radii()
   local rmax = 0
   for _, id in ipairs(ids) do rmax = math.max(rmax, rad:get(id)) end
-  local h = 2 * rmax
+  local key, cell_of = cell_grid(2 * rmax)
   local cells, counts = {}, {}
-  local function key(i, j, k) return (i * 4096 + j) * 4096 + k end
-  local function cell_of(id)
-    return math.floor(pos:get(id, 1) / h) + 2048, math.floor(pos:get(id, 2) / h) + 2048, math.floor(pos:get(id, 3) / h) + 2048
-  end
   for _, id in ipairs(ids) do
-    local c = key(cell_of(id))
+    local c = key(cell_of(pos:get(id, 1), pos:get(id, 2), pos:get(id, 3)))
     cells[c] = cells[c] or {}
     table.insert(cells[c], id)
   end
   for _, id in ipairs(ids) do
-    local ci, cj, ck = cell_of(id)
     local x, y, z, r = pos:get(id, 1), pos:get(id, 2), pos:get(id, 3), rad:get(id)
+    local ci, cj, ck = cell_of(x, y, z)
     local n = 0
     for di = -1, 1 do for dj = -1, 1 do for dk = -1, 1 do
       for _, j in ipairs(cells[key(ci + di, cj + dj, ck + dk)] or {}) do
@@ -232,10 +235,8 @@ function M.grow_floaters(world, o)
   end
   -- Cells of 4 rmax: every particle within a gap of 2 rmax of a centre is in the 27 cells around,
   -- also a floater placed before, which moved by up to rmax from the cell of its old centre.
-  local h = 4 * rmax
+  local key, cell_of = cell_grid(4 * rmax)
   local cells = {}
-  local function key(i, j, k) return (i * 4096 + j) * 4096 + k end
-  local function cell_of(x, y, z) return math.floor(x / h) + 2048, math.floor(y / h) + 2048, math.floor(z / h) + 2048 end
   local px, py, pz, pr = {}, {}, {}, {}
   for id = first, last do
     px[id], py[id], pz[id], pr[id] = pos:get(id, 1), pos:get(id, 2), pos:get(id, 3), rad:get(id)
