@@ -41,7 +41,7 @@ struct Group {
   Vec3 centre, velocity, angular_velocity;
   Vec3 applied{0, 0, 0};
   Vec3 force, torque;  // last step: contact + applied on members (torque about the centre)
-  Vec3 impulse{0, 0, 0};  // sum of force x dt since the world was made or loaded (time averages)
+  Vec3 impulse{0, 0, 0};  // sum of force x dt since the world was made (time averages)
 };
 
 // A rigid group's motion in the current step, for its members' moves and the ledgers

@@ -789,7 +789,10 @@ RunResult World::run(const RunPlan& plan) {
   const std::uint64_t limit = plan.steps > 0 ? plan.steps : std::numeric_limits<std::uint64_t>::max();
   const bool checks = plan.until_equilibrium || plan.stop_when || plan.callback;
   const std::uint64_t every = plan.every;
+  require(plan.steps_done < limit, "run: steps_done " + std::to_string(plan.steps_done) +
+                                       " must be below the step limit " + std::to_string(limit));
   RunResult r;
+  r.steps = plan.steps_done;
   std::uint64_t chunk = 1;
   while (r.steps < limit) {
     // Chunks of ~50 ms keep progress reports and interruptions responsive at no measurable cost

@@ -19,6 +19,10 @@
 --   shear      shear it under constant normal load (or stiffness) [4.3.1]
 --   report     summary.json, the plots, the result line
 --
+-- A run that is killed resumes (joint/checkpoint.lua): while closing and shearing it saves its
+-- state in out/.resume every `checkpoint_every` minutes and on SIGTERM, and the same command with
+-- the same `out=` continues from the last save to the files an uninterrupted run writes.
+--
 -- Models [scenarios.md 4]: rigid (each half one rigid body; only particles that can touch the
 -- other half are searched), elastic (unbreakable bonds), fracture (elliptic criterion with the
 -- calibrated bond strength; refused if the genesis left more than 1 % of the bonds above it).
@@ -122,6 +126,9 @@ local P = params_lib.parse{
   {"events_every", 0, type = "integer", min = 0,
    doc = "steps between energy samples for the event statistics (events.{h5,csv}); 0: none"},
   {"save", "", doc = "a path: the world's checkpoint when the shear ends"},
+  {"checkpoint_every", 5, unit = "min", min = 0,
+   doc = "while closing and shearing, save the run's state (out/.resume) every this many minutes of wall time "
+         .. "and on SIGTERM; the same command resumes from it (0: never)"},
   {"stop_after", "", oneof = {"", "packing"}, doc = "packing: stop once the halves are packed, before bonding"},
   check = function(P, fail, given)
     if P.residual_window >= P.shear then
@@ -178,13 +185,17 @@ end
 local run = require("joint.context").new(P)
 asperity.mkdir(P.cache)
 
+local checkpoint = require("joint.checkpoint")
 local genesis = require("joint.genesis")
 run.surface = genesis.surface(P)
+local saved = checkpoint.find(run)   -- a state this out= holds from an interrupted run, or nil
 if not genesis.specimen(run) then return run.genesis_record end   -- stop_after = "packing"
 local assembly = require("joint.assembly")
 assembly.prepare(run)
 require("joint.model").apply(run)
-assembly.first_contact(run)
-require("joint.closure").run(run)
-require("joint.shear").run(run)
-return require("joint.report").write(run)   -- the summary, for scripts that run this one (tests, the study)
+if saved then checkpoint.restore(run, saved) else assembly.first_contact(run) end
+if not saved or saved.phase == "closure" then require("joint.closure").run(run, saved) end
+require("joint.shear").run(run, saved and saved.phase == "shear" and saved or nil)
+local summary = require("joint.report").write(run)
+checkpoint.clear(run)   -- the summary written: nothing left to resume
+return summary          -- for scripts that run this one (tests, the study)

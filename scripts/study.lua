@@ -12,7 +12,8 @@
 -- DIR/.study/run.sh, which renames the folder to DIR/NAME once the run has written its summary
 -- (DIR/NAME.failed with the exit status if it failed). So a folder DIR/NAME is always a finished
 -- run, and rerunning the same command skips it: a run that was killed is left as NAME.part and
--- starts again. The runs of one surface and seed share one packed specimen (joint.lua's cache):
+-- resumes from the state it saved (joint.lua checkpoint_every; on SIGTERM too), or starts again
+-- if it saved none. The runs of one surface and seed share one packed specimen (joint.lua's cache):
 -- the first of them packs it, and the others start only once it is cached, so a specimen is
 -- packed once however many jobs run at once.
 --
@@ -188,8 +189,10 @@ local RUN_SH = [=[#!/bin/sh
 # STUDY/NAME.part/log.txt. On success (exit 0 and a summary.json) the folder is renamed to
 # STUDY/NAME, so a folder STUDY/NAME is always a finished run and a finished run is skipped; on
 # failure to STUDY/NAME.failed, with exit_status, which is skipped too unless RETRY is 1. A run
-# ended by a signal (kill, Ctrl-C: status above 128) stays STUDY/NAME.part and starts again next
-# time. WATCH_PID > 0: a process (the runner) whose end stops the run too.
+# ended by a signal (kill, Ctrl-C: status above 128) stays STUDY/NAME.part: next time it resumes
+# from the state it saved (joint.lua checkpoint_every, and on SIGTERM, which this script passes
+# on), or starts again if it saved none. WATCH_PID > 0: a process (the runner) whose end stops
+# the run too.
 set -u
 study=$(cd "$(dirname "$0")/.." && pwd)
 name=$1
@@ -204,11 +207,20 @@ exec 9>"$study/.study/locks/$name"
 flock -w 600 9 || { echo "run.sh: $name is locked by another process" >&2; exit 75; }
 [ -f "$final/summary.json" ] && exit 0
 [ "$retry" = 1 ] || [ ! -f "$failed/exit_status" ] || exit 0
-rm -rf "$part"
-mkdir -p "$part"
+# A run stopped part-way that saved its state (joint.lua's .resume) continues from it; any other
+# starts afresh.
+if [ -f "$part/.resume/state.lua" ] || [ -f "$part/.resume.old/state.lua" ]; then
+  echo "run.sh: resuming $name from its saved state" >> "$part/log.txt"
+else
+  rm -rf "$part"
+  mkdir -p "$part"
+fi
 printf '%s\n' "$cmd" > "$part/command.txt"
-sh -c "exec $cmd" > "$part/log.txt" 2>&1 9>&- &
+sh -c "exec $cmd" >> "$part/log.txt" 2>&1 9>&- &
 child=$!
+# SIGTERM (a batch system's time limit, a study runner stopping): passed on to the run, which
+# saves its state and ends; this script then waits for it.
+trap 'kill -TERM "$child" 2>/dev/null' TERM
 # A process that has ended but not been reaped yet (a zombie) still answers kill -0: read its state.
 alive() {
   if [ -r "/proc/$1/stat" ]; then
@@ -230,6 +242,11 @@ if [ "$watch" -gt 0 ]; then
 fi
 wait "$child"
 status=$?
+# A trapped signal ends the wait early: wait on for the run's own status.
+while alive "$child"; do
+  wait "$child"
+  status=$?
+done
 if [ "$status" -eq 0 ] && [ -f "$part/summary.json" ]; then
   rm -rf "$failed" "$final"
   mv "$part" "$final"
@@ -449,14 +466,18 @@ if P.slurm ~= "" then
 #   study %s: %d packing runs (one per surface and seed), then %d; %d threads per run
 #
 # Every task runs one joint.lua command through %s/.study/run.sh, the wrapper the runner uses:
-# finished runs are skipped, a run killed part-way starts again when its task runs again, a failed
-# run is kept in NAME.failed (and run again only if the script was written with retry=true).
-# Resubmit the same file to resume; gather the results on any machine with:
+# finished runs are skipped, a run killed part-way resumes from its saved state when its task runs
+# again, a failed run is kept in NAME.failed (and run again only if the script was written with
+# retry=true). A task near its time limit gets SIGTERM (--signal), passes it to its run, which
+# saves its state, and is requeued (--requeue) to resume. Resubmit the same file to resume what
+# is left; gather the results on any machine with:
 #   asperity run scripts/study.lua collect=true out=%s
 #SBATCH --job-name=asperity-study
 #SBATCH --ntasks=1
 #SBATCH --cpus-per-task=%d
 #SBATCH --output=%s/.study/slurm-%%A_%%a.out
+#SBATCH --signal=B:TERM@180
+#SBATCH --requeue
 set -u
 study=%s
 if [ -z "${SLURM_ARRAY_TASK_ID:-}" ]; then
@@ -482,7 +503,20 @@ run)
   esac ;;
 *) echo "usage: bash $0 (submits), or as an array task with the argument pack or run" >&2; exit 2 ;;
 esac
-exec sh "$study/.study/run.sh" "$name" 0 %d "$cmd"
+sh "$study/.study/run.sh" "$name" 0 %d "$cmd" &
+child=$!
+trap 'kill -TERM "$child" 2>/dev/null' TERM
+wait "$child"
+status=$?
+while kill -0 "$child" 2>/dev/null; do
+  wait "$child"
+  status=$?
+done
+# Stopped by the time limit's SIGTERM with its state saved: back in the queue, to resume.
+if [ "$status" -gt 128 ] && [ -n "${SLURM_ARRAY_JOB_ID:-}" ]; then
+  scontrol requeue "${SLURM_ARRAY_JOB_ID}_${SLURM_ARRAY_TASK_ID}"
+fi
+exit "$status"
 ]=]):format(P.slurm, DIR, #packers, #others, threads, DIR, DIR, threads, DIR, shell_quote(DIR),
              #packers - 1, #others, cases(packers), cases(others), P.retry and 1 or 0)
   write_atomic(P.slurm, text)
@@ -692,7 +726,7 @@ local function run_all()
             failure_message(DIR .. "/" .. name .. ".failed"), done, todo, overall_left())
       else
         failed_now = failed_now + 1
-        log("INTERRUPTED %s after %s (stopped by a signal; it starts again on the next run of the study)",
+        log("INTERRUPTED %s after %s (stopped by a signal; the next run of the study resumes it)",
             name, clock(seconds))
       end
       write_tables(gather(runs))
@@ -706,7 +740,7 @@ if not ok then
     local names = {}
     for name in pairs(running) do names[#names + 1] = name end
     table.sort(names)
-    log("interrupted: %s left part-way (started again by the same command)",
+    log("interrupted: %s left part-way (resumed by the same command)",
         #names > 0 and table.concat(names, ", ") or "no run")
     write_tables(gather(runs))
     os.exit(130)

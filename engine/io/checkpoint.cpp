@@ -29,7 +29,7 @@ namespace asperity {
 namespace {
 
 using detail::State;
-constexpr int kCheckpointVersion = 9;  // 2: servo integral and integral time, group damping;
+constexpr int kCheckpointVersion = 10;  // 2: servo integral and integral time, group damping;
                                        // 3: rest overlaps (stress-free bonds);
                                        // 4: meshes' candidates within half the skin;
                                        // 5: a header with a checksum in the HDF5 user block;
@@ -37,7 +37,8 @@ constexpr int kCheckpointVersion = 9;  // 2: servo integral and integral time, g
                                        // 7: bonds broken per particle;
                                        // 8: overlap_limit;
                                        // 9: contact bonds apart from the beam (what holds,
-                                       //    contact_strength, the kind of a break)
+                                       //    contact_strength, the kind of a break);
+                                       // 10: the groups' impulse (a resumed run's interval means)
 
 // The file's kind in the header of its HDF5 user block (io::h5::file_image), whose checksum is
 // verified before HDF5 parses the file: HDF5 does not survive every corruption of its metadata.
@@ -355,6 +356,7 @@ void visit(Io& io, State& s) {
     io.vec(at + "/applied", grp.applied);
     io.vec(at + "/force", grp.force);
     io.vec(at + "/torque", grp.torque);
+    if (io.version >= 10) io.vec(at + "/impulse", grp.impulse);
     GroupMotion& m = grp.motion;
     std::vector<std::uint8_t> modes{std::uint8_t(m.translation[0]), std::uint8_t(m.translation[1]),
                                     std::uint8_t(m.translation[2]), std::uint8_t(m.rotation)};

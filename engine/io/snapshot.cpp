@@ -9,7 +9,9 @@
 // as /particles/index) rather than the implicit form, which some readers handle differently.
 // Contacts are a Polyline topology with two nodes per element, the two particles' rows, over the
 // same positions: ParaView then draws the force chains as lines and colours them by force.
+#include <algorithm>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 #include <unordered_map>
 
@@ -255,11 +257,49 @@ SnapshotSeries::SnapshotSeries(std::filesystem::path directory, std::string name
   if (name_.empty() || name_.find('/') != std::string::npos)
     throw Error("snapshot series name '" + name_ + "' must be a plain file name");
   make_directories(directory_);
+  for (std::size_t k = 0; k < options_.keep; ++k) {
+    const std::string file = file_name(k);
+    const std::filesystem::path path = directory_ / file;
+    if (!std::filesystem::exists(path))
+      throw Error("cannot continue the snapshot series '" + name_ + "': " + path.string() + " (snapshot " +
+                  std::to_string(k + 1) + " of " + std::to_string(options_.keep) + ") is missing");
+    auto number = [&](const char* attribute) -> std::optional<double> {
+      auto a = read_hdf5_attribute(path, "/", attribute);
+      if (!a) return std::nullopt;
+      if (const auto* d = std::get_if<double>(&*a)) return *d;
+      if (const auto* i = std::get_if<std::int64_t>(&*a)) return static_cast<double>(*i);
+      return std::nullopt;
+    };
+    const auto step = number("step"), time = number("time");
+    if (!step || !time) throw Error("cannot continue the snapshot series '" + name_ + "': " + path.string() +
+                                    " is not one of its snapshots (no step or time)");
+    const auto datasets = hdf5_datasets(path);
+    auto has = [&](const char* d) { return std::find(datasets.begin(), datasets.end(), d) != datasets.end(); };
+    auto rows = [&](const char* d) { return has(d) ? hdf5_shape(path, d).at(0) : std::size_t{0}; };
+    entries_.push_back(Entry{file, static_cast<std::uint64_t>(*step), number("index_time").value_or(*time),
+                             rows("/particles/id"), rows("/contacts/id_a"), rows("/bonds/id_a"),
+                             has("/contacts/id_a"), has("/bonds/id_a")});
+    // Each particle's displacement is measured from the first snapshot it appeared in.
+    const std::vector<double> ids = read_hdf5(path, "/particles/id");
+    const std::vector<double> x = read_hdf5(path, "/particles/position");
+    for (std::size_t i = 0; i < ids.size() && 3 * i + 2 < x.size(); ++i)
+      reference_.emplace(static_cast<std::int64_t>(ids[i]), std::array<double, 3>{x[3 * i], x[3 * i + 1], x[3 * i + 2]});
+  }
   std::error_code ec;
   for (const auto& entry : std::filesystem::directory_iterator(directory_, ec)) {
     if (!entry.is_regular_file()) continue;
-    if (is_series_file(entry.path().filename().string(), name_)) std::filesystem::remove(entry.path(), ec);
+    const std::string file = entry.path().filename().string();
+    if (!is_series_file(file, name_)) continue;
+    const bool kept = std::any_of(entries_.begin(), entries_.end(), [&](const Entry& e) { return e.file == file; });
+    if (!kept) std::filesystem::remove(entry.path(), ec);
   }
+  if (!entries_.empty()) write_xdmf();
+}
+
+std::string SnapshotSeries::file_name(std::size_t index) const {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "_%06zu.h5", index);
+  return name_ + buf;
 }
 
 std::filesystem::path SnapshotSeries::xdmf_path() const { return directory_ / (name_ + ".xdmf"); }
@@ -271,9 +311,7 @@ std::filesystem::path SnapshotSeries::bonds_xdmf_path() const {
 }
 
 std::filesystem::path SnapshotSeries::write(Snapshot snapshot) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "_%06zu.h5", entries_.size());
-  std::string file = name_ + buf;
+  const std::string file = file_name(entries_.size());
   const std::size_t n = snapshot.id.size();
   snapshot.displacement.assign(3 * n, 0.0);
   for (std::size_t i = 0; i < n; ++i) {

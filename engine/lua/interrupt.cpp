@@ -3,6 +3,7 @@
 
 #include <atomic>
 #include <csignal>
+#include <cstdio>
 
 #include "asperity/world.hpp"
 #include "lua/binding.hpp"
@@ -92,6 +93,48 @@ int l_is_interrupted(lua_State* L) {
   return 1;
 }
 
+// SIGTERM, caught on request by a script that saves its state before it goes (a batch system's
+// time limit, a study runner stopping its runs): while caught, the signal only sets a flag that
+// the script polls at its own safe points; when the catch ends, a request it did not serve ends
+// the process as the signal would have.
+std::atomic<bool> terminate_flag{false};
+bool terminate_caught = false;
+
+void on_sigterm(int) { terminate_flag = true; }
+
+void end_as_terminated() {
+  std::fflush(nullptr);
+  std::signal(SIGTERM, SIG_DFL);
+  std::raise(SIGTERM);
+}
+
+int l_catch_terminate(lua_State* L) {
+  luaL_checktype(L, 1, LUA_TBOOLEAN);
+  const bool on = lua_toboolean(L, 1);
+  if (on && !terminate_caught) {
+    struct sigaction sa {};
+    sa.sa_handler = on_sigterm;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESTART;  // the script's file writes go on undisturbed
+    sigaction(SIGTERM, &sa, nullptr);
+  } else if (!on && terminate_caught) {
+    std::signal(SIGTERM, SIG_DFL);
+    if (terminate_flag.load()) end_as_terminated();
+  }
+  terminate_caught = on;
+  return 0;
+}
+
+int l_terminate_requested(lua_State* L) {
+  lua_pushboolean(L, terminate_flag.load());
+  return 1;
+}
+
+int l_terminate(lua_State*) {
+  end_as_terminated();
+  return 0;
+}
+
 }  // namespace
 
 void make_interruption(lua_State* L) {
@@ -117,7 +160,17 @@ void open_interrupt(lua_State* L) {
       {"is_interrupted", l_is_interrupted, "asperity.is_interrupted(err) -> boolean",
        "Whether an error value (from pcall) is a Ctrl-C rather than a failure. An interruption\n"
        "is an error object, not a string: tostring(err) gives its message, \"file:line:\n"
-       "interrupted ...\". A failure whose message says \"interrupted\" is not one."}};
+       "interrupted ...\". A failure whose message says \"interrupted\" is not one."},
+      {"catch_terminate", l_catch_terminate, "asperity.catch_terminate(on)",
+       "true: a SIGTERM (a batch job's time limit, kill) only sets a flag, read by\n"
+       "asperity.terminate_requested(), so the script can save its state at a safe point and\n"
+       "then call asperity.terminate(). false: the default again; a request not served ends\n"
+       "the process now, as the signal would have."},
+      {"terminate_requested", l_terminate_requested, "asperity.terminate_requested() -> boolean",
+       "Whether a SIGTERM arrived while caught (asperity.catch_terminate)."},
+      {"terminate", l_terminate, "asperity.terminate()",
+       "Ends the process as a SIGTERM does (exit status 143 in a shell), output flushed: after a\n"
+       "script saved its state on asperity.terminate_requested()."}};
   register_functions(L, -1, fns);
 }
 

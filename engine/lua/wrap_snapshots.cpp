@@ -43,6 +43,9 @@ int snapshots_new(lua_State* L) {
     bool contacts = o.boolean("contacts", true);
     io::SnapshotSeriesOptions options;
     options.time_label = o.string("time", "");
+    lua_Integer keep = o.integer("keep", 0);
+    if (keep < 0) throw Error("asperity.snapshots: option 'keep' must be >= 0 (snapshots already written)");
+    options.keep = static_cast<std::size_t>(keep);
     std::optional<lua_Integer> exclude;
     if (o.present("exclude_tag")) exclude = o.integer("exclude_tag", 0);
     if (o.push_checked("keys", LUA_TTABLE, "a table {group = \"1: ...\", tag = \"...\"}") == LUA_TTABLE) {
@@ -129,13 +132,15 @@ void open_snapshots(lua_State* L) {
   static const Function fns[] = {
       {"snapshots", snapshots_new,
        "asperity.snapshots{dir= [, name=\"particles\"] [, contacts=true] [, time=label] [, keys={field=legend}]\n"
-       "                   [, exclude_tag=n]}",
+       "                   [, exclude_tag=n] [, keep=n]}",
        "A snapshot writer into dir (created if needed): NAME_000000.h5, ... and NAME.xdmf;\n"
        "with contacts, also NAME_contacts.xdmf (contacts as lines, for force chains), and\n"
        "NAME_bonds.xdmf when the world has bonds. Files of an earlier series NAME in dir are\n"
-       "removed first. time: what the times given to write() are (e.g. \"shear displacement (mm)\");\n"
+       "removed first (but see keep). time: what the times given to write() are (e.g. \"shear displacement (mm)\");\n"
        "keys: legends of integer fields, stored as /particles attributes FIELD_key and in the\n"
-       "XDMF; exclude_tag: particles with this tag are left out of the files."},
+       "XDMF; exclude_tag: particles with this tag are left out of the files. keep: continue a\n"
+       "series whose first n snapshots an interrupted run wrote (a resumed run): they are kept\n"
+       "and read back, later ones removed; the next write is snapshot n + 1."},
   };
   register_functions(L, -1, fns);
 }

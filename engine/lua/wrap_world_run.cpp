@@ -105,6 +105,11 @@ int world_run(lua_State* L) {
       throw Error(ctx + ": option 'sample' needs sample_every = (steps between samples, >= 1)");
     if (sample_type == LUA_TNIL && o.present("sample_every"))
       throw Error(ctx + ": option 'sample_every' needs sample = (a function(world))");
+    lua_Integer steps_done = o.integer("steps_done", 0);
+    if (steps_done < 0) throw Error(ctx + ": option 'steps_done' must be >= 0");
+    if (steps > 0 && steps_done >= steps)
+      throw Error(ctx + ": option 'steps_done' (" + std::to_string(steps_done) + ") must be below steps (" +
+                  std::to_string(steps) + ")");
     bool progress = o.boolean("progress", true);
     int show_type = o.push_checked("show", LUA_TFUNCTION, "a function(world) returning a string or table");
     int show = lua_gettop(L);
@@ -119,6 +124,7 @@ int world_run(lua_State* L) {
     plan.until_equilibrium = equilibrium;
     plan.ratio = ratio;
     plan.every = static_cast<std::uint64_t>(every);
+    plan.steps_done = static_cast<std::uint64_t>(steps_done);
     if (callback_type != LUA_TNIL) plan.callback = [&] { call_with_world(L, callback, 0); };
     if (sample_type != LUA_TNIL) {
       plan.sample_every = static_cast<std::uint64_t>(sample_every);
@@ -244,7 +250,7 @@ std::span<const Function> world_run_methods() {
        "Advances n steps (1). Ctrl-C stops it at the next step with an interruption (asperity.is_interrupted(err) is true)."},
       {"run", world_run,
        "world:run{steps= [, stop_when=] [, ratio=] [, every=] [, callback=] [, progress=] [, show=]\n"
-       "          [, fraction=] [, sample_every=, sample=]}\n"
+       "          [, fraction=] [, sample_every=, sample=] [, steps_done=]}\n"
        "  -> steps, reason",
        "Runs up to `steps` steps, or until stop_when: a function(world) returning true, or\n"
        "\"equilibrium\" (unbalanced-force ratio <= ratio, default 1e-4). stop_when and\n"
@@ -256,6 +262,8 @@ std::span<const Function> world_run_methods() {
        "progress=false: never); show(world) returns a string or a table of values to add to it;\n"
        "fraction(world) returns the completion 0..1 for the percent and ETA when stop_when, not\n"
        "steps, ends the run (with stop_when, steps is only a cap and gives neither).\n"
+       "steps_done: steps of this run done before (a run resumed from a checkpoint): the cap and\n"
+       "the cadences count on from there, so hooks run at the steps an unbroken run's would.\n"
        "reason: \"steps\", \"equilibrium\" or \"stop_when\"."},
       {"dt", world_dt, "world:dt() -> s", "The time step in use."},
       {"set_dt", set_world_number<&World::set_dt>, "world:set_dt(dt)", "Fixes the time step (0: automatic again)."},

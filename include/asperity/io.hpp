@@ -201,6 +201,10 @@ void write_snapshot_hdf5(const std::filesystem::path& path, const Snapshot& snap
 struct SnapshotSeriesOptions {
   std::string time_label;   // what the XDMF time is, e.g. "shear displacement (mm)"; "" = time (s)
   Attributes keys;          // legends written on /particles, e.g. {"group_key", "1: lower platen"}
+  // Continue a series whose first `keep` snapshots a run interrupted earlier wrote (a resumed
+  // run): they are read back (index, and the first positions the displacements are measured
+  // from) and any later files removed. 0: a new series, every file of the name removed.
+  std::size_t keep = 0;
 };
 class SnapshotSeries {
  public:
@@ -220,6 +224,7 @@ class SnapshotSeries {
     bool has_contacts, has_bonds;
   };
   void write_xdmf() const;
+  std::string file_name(std::size_t index) const;
   std::filesystem::path directory_;
   std::string name_;
   SnapshotSeriesOptions options_;

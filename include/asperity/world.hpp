@@ -295,6 +295,10 @@ struct RunPlan {
   // series does not make the callback and the stop condition run as often.
   std::uint64_t sample_every = 0;
   std::function<void()> sample;
+  // Steps of this run done before (a run resumed from a checkpoint): the step limit, the checks'
+  // and the samples' cadences count on from there, so the resumed run calls its hooks at the
+  // steps the uninterrupted one would have. RunResult::steps includes them.
+  std::uint64_t steps_done = 0;
 };
 
 struct RunResult {
@@ -370,8 +374,8 @@ class World {
   const GroupMotion& group_motion(int group) const;
   void set_group_applied_force(int group, Vec3 f);
   Vec3 group_force(int group) const;       // sum of contact + applied forces on members, last step
-  // Sum of group_force x dt over the steps since the world was made or loaded (not checkpointed):
-  // the mean force over an interval is the change of the impulse over the change of time(), what
+  // Sum of group_force x dt over the steps since the world was made (checkpointed since version 10;
+  // 0 when an older checkpoint is loaded): the mean force over an interval is the change of the impulse over the change of time(), what
   // a load cell with a low-pass filter reads, without sampling every step.
   Vec3 group_impulse(int group) const;
   Vec3 group_torque(int group) const;      // about the centre of mass

@@ -90,6 +90,10 @@ void restart_continues_bit_for_bit(bool stress_free_bonds) {
   EXPECT_NEAR(c.friction, a.friction, 1e-12 * a.friction);
   EXPECT_EQ(w.group_position(0), r.group_position(0));
   EXPECT_EQ(w.group_position(0), q.group_position(0));
+  // The platen's impulse goes on from its saved sum, so a resumed run's interval means are those
+  // of the unbroken run.
+  EXPECT_NE(w.group_impulse(0).z, 0.0);
+  EXPECT_EQ(w.group_impulse(0), r.group_impulse(0));
   std::filesystem::remove(path);
 }
 }  // namespace

@@ -238,6 +238,58 @@ TEST(Snapshot, IndexTimeDisplacementExclusionAndStaleFiles) {
   fs::remove_all(dir);
 }
 
+// A resumed run continues its series (SnapshotSeriesOptions::keep): the kept snapshots stay, the
+// later ones an interrupted run wrote go, the index and the displacements go on as if unbroken.
+TEST(Snapshot, KeepContinuesASeriesAsIfUnbroken) {
+  fs::path dir = fresh_dir("snapshot_keep");
+  fs::path other = fresh_dir("snapshot_keep_unbroken");
+  WorldSettings settings;
+  settings.contact.kn = 1e3;
+  World world(settings);
+  for (int i = 0; i < 3; ++i) world.add_particle({0.0199 * i, 0, 0}, 0.01);
+  world.cycle(1);
+  auto take = [&](double index_time) {
+    io::Snapshot s = io::take_snapshot(world, true, 1);
+    s.index_time = index_time;
+    return s;
+  };
+  io::SnapshotSeriesOptions options;
+  options.time_label = "closure (mm)";
+  io::SnapshotSeries unbroken(other, "p", options);
+  {
+    io::SnapshotSeries first(dir, "p", options);
+    first.write(take(0.0));
+    unbroken.write(take(0.0));
+    world.set_position(2, {0.05, 0.01, -0.02});
+    first.write(take(1.0));
+    unbroken.write(take(1.0));
+    first.write(take(2.0));  // written after the state the run resumes from: goes
+  }
+  options.keep = 2;
+  io::SnapshotSeries resumed(dir, "p", options);
+  EXPECT_EQ(resumed.count(), 2u);
+  EXPECT_TRUE(fs::exists(dir / "p_000001.h5"));
+  EXPECT_FALSE(fs::exists(dir / "p_000002.h5"));
+  world.set_position(1, {0.02, 0.03, 0.0});
+  const fs::path file = resumed.write(take(2.0));
+  const fs::path same = unbroken.write(take(2.0));
+  EXPECT_EQ(file.filename(), "p_000002.h5");
+  EXPECT_EQ(io::read_hdf5(file, "/particles/displacement"), io::read_hdf5(same, "/particles/displacement"));
+  EXPECT_NE(io::read_hdf5(file, "/particles/displacement"), std::vector<double>(9, 0.0));
+  EXPECT_EQ(read_text(resumed.xdmf_path()), read_text(unbroken.xdmf_path()));
+  EXPECT_EQ(read_text(resumed.contacts_xdmf_path()), read_text(unbroken.contacts_xdmf_path()));
+
+  options.keep = 5;  // more than there are
+  try {
+    io::SnapshotSeries wrong(dir, "p", options);
+    ADD_FAILURE() << "keep beyond the files on disk must be refused";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("p_000003.h5 (snapshot 4 of 5) is missing"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+  fs::remove_all(other);
+}
+
 TEST(Snapshot, DropParticlesRenumbersTheContactRows) {
   WorldSettings settings;
   settings.contact.kn = 1e3;

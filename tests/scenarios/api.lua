@@ -78,6 +78,19 @@ local sampled = {}
 n = w:run{steps = 70, every = 50, sample_every = 20, sample = function(w) sampled[#sampled + 1] = w:step() end}
 assert(n == 70 and #sampled == 3 and sampled[1] == 540 and sampled[3] == 580, "samples at " .. table.concat(sampled, " "))
 assert(w:cycle(5) == 5 and w:step() == 595)
+do  -- a run resumed with steps_done: the cap and the cadences count on from there (checks at 40,
+    -- 50 of the run; samples at 48, 60), so 595 + 17 steps end a run of 60 begun 43 steps earlier
+  local checks, samples = {}, {}
+  n = w:run{steps = 60, every = 10, steps_done = 43, callback = function(w) checks[#checks + 1] = w:step() end,
+            sample_every = 12, sample = function(w) samples[#samples + 1] = w:step() end}
+  assert(n == 60 and w:step() == 612, ("steps_done: %d steps, at %d"):format(n, w:step()))
+  assert(table.concat(checks, " ") == "602 612", "checks at " .. table.concat(checks, " "))
+  assert(table.concat(samples, " ") == "600 612", "samples at " .. table.concat(samples, " "))
+  local ok, err = pcall(function() return w:run{steps = 10, steps_done = 10} end)
+  assert(not ok and err:find("option 'steps_done' (10) must be below steps (10)", 1, true), err)
+  ok, err = pcall(function() return w:run{steps = 10, steps_done = -1} end)
+  assert(not ok and err:find("option 'steps_done' must be >= 0", 1, true), err)
+end
 assert(w:dt() > 0 and w:time() > 0 and w:critical_dt() > 0)
 assert(type(w:simd()) == "string" and w:stats().rebuilds >= 1)
 local e = w:energies()

@@ -14,18 +14,21 @@ local assembly = require("joint.assembly")
 
 local M = {}
 
-function M.run(run)
+-- saved: the state of a run interrupted in its closure (joint/checkpoint.lua), to resume from.
+function M.run(run, saved)
   local P, world = run.P, run.world
   local area, top, target_stress = run.area, run.top, run.target_stress
-  run.z_contact = world:group_position(top)[3]
+  if not saved then run.z_contact = world:group_position(top)[3] end
   local z_contact = run.z_contact
   asperity.mkdir(P.out)
   local function closure_mm() return 1e3 * (z_contact - world:group_position(top)[3]) end
-  local closure_snaps = run:snapshots("joint_closure", "closure (mm)")
-  closure_snaps:write(world, {stage = "closure", closure_mm = 0, stress_scale = run.stress_scale}, 0)
-  local closure = asperity.series{"closure [mm]", "closure_corrected [mm]", "normal_stress [" .. context.MODEL_PA .. "]",
-    "normal_stress_mpa [" .. context.ROCK_MPA .. "]", "contacts [1]", "contact_area [%]", "broken_bonds [1]", "time [s]"}
-  run.closure = closure
+  local closure_snaps = run:snapshots("joint_closure", "closure (mm)", saved and saved.snaps.joint_closure)
+  if not saved then
+    closure_snaps:write(world, {stage = "closure", closure_mm = 0, stress_scale = run.stress_scale}, 0)
+    run.closure = asperity.series{"closure [mm]", "closure_corrected [mm]", "normal_stress [" .. context.MODEL_PA .. "]",
+      "normal_stress_mpa [" .. context.ROCK_MPA .. "]", "contacts [1]", "contact_area [%]", "broken_bonds [1]", "time [s]"}
+  end
+  local closure = run.closure
   local height = run.zhi - run.zlo
   local function record_closure()
     run:track_overlap("closure")
@@ -36,14 +39,25 @@ function M.run(run)
                    100 * c.area / area, world:break_count(), world:time())
   end
   local closure_every = P.closure_every > 0 and P.closure_every or (P.model == "rigid" and 1 or 50)
-  record_closure()
-  world:run{steps = 10000000, every = 1, progress = P.progress,
+  if not saved then record_closure() end
+  local steps_done = saved and saved.steps_done or 0
+  local first_step = world:step() - steps_done
+  run.checkpoint:catch_terminate()
+  world:run{steps = 10000000, every = 1, progress = P.progress, steps_done = steps_done,
             callback = function(w)
               if run.moved_steps < run.ramp_steps then assembly.approach_velocity(run, w, 1) end
               if w:step() % closure_every == 0 then record_closure() end
               if run.escape_every > 0 and w:step() % run.escape_every == 0 then run:remove_escaped() end
             end,
-            stop_when = function() return run:normal_stress() >= target_stress end,
+            -- The last thing of a check: a state saved here resumes with the next step.
+            stop_when = function(w)
+              if run:normal_stress() >= target_stress then return true end
+              run.checkpoint:poll(function()
+                return {phase = "closure", steps_done = w:step() - first_step,
+                        snaps = {joint_closure = closure_snaps:count()}}
+              end)
+              return false
+            end,
             fraction = function() return run:normal_stress() / target_stress end,
             show = function()
               return {closure_um = 1e6 * (z_contact - world:group_position(top)[3]),

@@ -9,6 +9,7 @@
 -- What the phases leave in it:
 --   new        P, t_start, stress_scale, target_stress (model Pa), applied_z, overlap_max,
 --              overlap_at, escaped_count
+--   checkpoint checkpoint (joint/checkpoint.lua: saves the state, resumes from it), resumes
 --   genesis    surface (the height map and the mould), cache_file, world, genesis_record
 --   assembly   N, lower, upper (ids of the halves), upper_mean_z_mould, pos, rad, prof_lower,
 --              prof_upper, plane_lower, cls, area, ramp_steps, moved_steps
@@ -67,11 +68,12 @@ end
 
 -- Particle snapshots (HDF5 + XDMF) indexed by `label` (the shear or the closure displacement in
 -- mm), with the keys of the integer fields; the particles left out of the specimen are not
--- written, so they are not drawn as debris between the halves.
-function Run:snapshots(name, label)
+-- written, so they are not drawn as debris between the halves. keep: the snapshots a resumed run
+-- wrote before (joint/checkpoint.lua).
+function Run:snapshots(name, label, keep)
   local groups = self.P.model == "rigid" and ("%d: lower half (rigid), %d: upper half (rigid), -1: none")
                  or ("%d: lower platen, %d: upper platen, -1: none (bonded particles)")
-  return asperity.snapshots{dir = self.P.out, name = name, time = label, exclude_tag = M.LOST,
+  return asperity.snapshots{dir = self.P.out, name = name, time = label, exclude_tag = M.LOST, keep = keep,
                             keys = {group = groups:format(self.bottom, self.top),
                                     tag = ("%d: lower half, %d: upper half"):format(M.LOWER, M.UPPER)}}
 end

@@ -246,7 +246,8 @@ function M.write(run)
     shear_seconds = run.shear_seconds,
     shear_microseconds_per_step = 1e6 * run.shear_seconds / math.max(run.shear_steps, 1),  -- cost of one step
     dt = world:dt(),
-    wall_seconds = asperity.wall_time() - run.t_start,
+    wall_seconds = asperity.wall_time() - run.t_start,   -- of every attempt, when resumed
+    resumes = run.resumes or 0,              -- times the run was resumed from its saved state
     specimen_cache = run.cache_file,
     specimen_packed = run.specimen_packed,   -- packed by this run (its wall time includes the genesis)
     specimen_seconds = run.specimen_seconds, -- the genesis (packed, bonded, relaxed) or the cache's loading
