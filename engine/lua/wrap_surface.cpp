@@ -1,7 +1,7 @@
 // asperity.surface: rough surfaces (include/asperity/surface.hpp) from Lua - the spectral
 // generator, the reference surfaces S1..S8, height-map files, the roughness analysis, and the
 // steps from a synthetic surface to a DEM surface (profilometer, mean plane, surface vs porosity
-// particles, noise study). Spec: shared/spec/surfaces.md.
+// particles, noise study). Spec: docs/surfaces.md.
 //
 //   local s = asperity.surface.generate{name = "S5", n = 365, seed = 1}   -- a HeightMap
 //   local r = s:analyze()            -- r.hurst_psd.hurst, r.amplitude.variance, r.psd_radial...

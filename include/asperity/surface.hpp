@@ -1,5 +1,5 @@
 // asperity/surface.hpp - self-affine rough surfaces: spectral generator, height maps, roughness
-// analysis and height-map files. Specification: shared/spec/surfaces.md sections 1, 2 and 4.
+// analysis and height-map files. Specification: docs/surfaces.md sections 1, 2 and 4.
 //
 // Design notes
 // - Plain data in, plain data out: every result is a struct of doubles and std::vector<double>,
