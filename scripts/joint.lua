@@ -46,7 +46,7 @@ local P = params_lib.parse{
   {"surface", "S1", oneof = {"S1", "S2", "S3", "S4", "S5", "S6", "S7", "S8", "flat"},
    doc = "reference surface (surfaces.md table 4), or flat: a plane, the control case"},
   {"surface_file", "", file = true, doc = "an HDF5 height map instead (dataset `height`, attribute `spacing`)"},
-  {"scale", "", oneof = {"", "thesis"}, doc = "thesis: size 0.1 m (about 110 000 particles) unless size is given"},
+  {"scale", "", oneof = {"", "thesis"}, doc = "thesis: size 0.1 m (about 91 000 particles) unless size is given"},
   {"size", 0.05, unit = "m", min = 4 * R, doc = "side of the square joint (scenarios.md 3: 5 cm; 2 cm is a fast check of the machinery)"},
   {"thickness", 0.006, unit = "m", min = 2 * R, doc = "each half beyond the mean plane"},
   {"spacing", 0.1 / 365, unit = "m", above = 0, doc = "surface grid spacing (the thesis grid)"},
@@ -56,7 +56,7 @@ local P = params_lib.parse{
   {"direction", "x", oneof = {"x", "y"}, doc = "the upper half moves along -x or -y"},
   {"shear", 5, unit = "mm", above = 0, doc = "shear displacement"},
   {"residual_window", 0.5, unit = "mm", above = 0, doc = "the residual stress is the mean over the last this much of the shear"},
-  {"velocity", 1.5e-5, unit = "m/s", above = 0, doc = "shear velocity (perf/runtime_vs_error.lua: within 1 % of a 2x slower run)"},
+  {"velocity", 1.5e-5, unit = "m/s", above = 0, doc = "shear velocity (perf/runtime_vs_error.lua: within 1 % of a 4x slower run)"},
   {"speedup", 1, type = "integer", oneof = {1, 2, 4},
    doc = "after the peak the shear velocity may double at each record, up to this many times "
       .. "`velocity`, while the specimen stays quasi-static (speedup_kinetic); 1: constant velocity; the elastic model only"},

@@ -62,7 +62,7 @@ local P = params_lib.parse{
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "isotropic stress the genesis installs before bonding (model units)"},
   {"floater_contacts", mat.genesis.floater_contacts, type = "integer", min = 0,
    doc = "particles with fewer contacts are floaters"},
-  {"grow_floaters", mat.genesis.grow_floaters, doc = "floaters get the radius that makes them touch floater_contacts (else they are taken out)"},
+  {"grow_floaters", mat.genesis.grow_floaters, doc = "floaters get the radius and place at which they touch four neighbours (else they are taken out)"},
   {"tensile_strength", rev.bond_tensile_strength, unit = "Pa", above = 0,
    doc = "bond strength st of the elliptic criterion (model units; the calibrated one by default)"},
   {"bond_shear_ratio", rev.bond_shear_ratio, min = 0, doc = "kbs / kbn of the parallel bonds"},
