@@ -42,4 +42,13 @@ std::string field_problem(const Field& f, const Table& t) {
   return problem.empty() ? problem : std::string(f.name) + ": " + problem;
 }
 
+// The rule between two fields of a bond material, checked where bonds get a material (installed,
+// their strength set): a breakable bond needs a strength. (A checkpoint of a world without bonds
+// holds the default material, breakable without one: not a damaged file.)
+inline std::string bond_material_problem(const BondMaterial& m) {
+  if (!m.breakable || (m.tensile_strength > 0 && std::isfinite(m.tensile_strength))) return {};
+  return "a breakable bond needs tensile_strength > 0 (Pa), got " + short_number_text(m.tensile_strength) +
+         ": give it, or breakable = false for unbreakable bonds";
+}
+
 }  // namespace asperity::detail

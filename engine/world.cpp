@@ -640,13 +640,15 @@ World::ContactStress World::contact_stress(int tag, double volume) const {
 
 // --- bonds ---------------------------------------------------------------------------------
 
-std::size_t World::install_bonds(const BondMaterial& material, double tolerance,
+std::size_t World::install_bonds(const BondMaterial& given, double tolerance,
                                  std::span<const std::int64_t> ids, bool stress_free) {
   State& s = *state_;
-  check_value("", Field{"bond material"}, material);
-  require(!material.breakable || material.tensile_strength > 0,
-          "bond material: a breakable bond needs tensile_strength > 0 (Pa), got " +
-              num(material.tensile_strength) + "; set breakable = false for unbreakable bonds");
+  check_value("install_bonds: ", Field{"bond material"}, given);
+  BondMaterial material = given;  // the beam's stiffness left at 0: the contact springs' (model.md 5)
+  if (material.beam_kn == 0) material.beam_kn = s.settings.contact.kn;
+  if (material.beam_ks == 0) material.beam_ks = material.beam_kn / 10;
+  const std::string problem = detail::bond_material_problem(material);
+  require(problem.empty(), "install_bonds: " + problem);
   if (s.bonds.n + s.frozen_bonds.n > 0)
     require(s.bonds.material == material,
             "install_bonds: the world already holds bonds of another material (one bond material "
@@ -673,9 +675,6 @@ std::size_t World::bond_count() const {
 void World::set_bond_strength(double tensile_strength, bool breakable, std::optional<double> contact_strength,
                               std::optional<double> contact_shear_strength,
                               std::optional<double> contact_bond_friction) {
-  require(!breakable || (tensile_strength > 0 && std::isfinite(tensile_strength)),
-          "set_bond_strength: a breakable bond needs tensile_strength > 0 (Pa), got " +
-              num(tensile_strength));
   BondMaterial m = state_->bonds.material;
   m.tensile_strength = breakable ? tensile_strength : 0.0;
   m.breakable = breakable;
@@ -683,6 +682,8 @@ void World::set_bond_strength(double tensile_strength, bool breakable, std::opti
   if (contact_shear_strength) m.contact_shear_strength = *contact_shear_strength;
   if (contact_bond_friction) m.contact_bond_friction = *contact_bond_friction;
   check_value("set_bond_strength: ", Field{"bond material"}, m);
+  const std::string problem = detail::bond_material_problem(m);
+  require(problem.empty(), "set_bond_strength: " + problem);
   for (detail::BondStore* q : {&state_->bonds, &state_->frozen_bonds}) q->material = m;
 }
 

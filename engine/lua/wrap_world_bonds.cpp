@@ -32,22 +32,15 @@ int world_install_bonds(lua_State* L) {
     World& w = world_arg(L);
     const std::string ctx = "world:install_bonds";
     Options o(L, 2, ctx, 2);
-    // Defaults of the Lua layer: the beam as stiff as the world's contact springs (model.md 5:
-    // kbn A = kn, kbs = kbn / 10), not the C++ struct's constants; a breakable bond needs its
-    // strength given.
-    const bool ks_given = o.present("beam_ks"), st_given = o.present("tensile_strength");
+    // The material's defaults and its checks are the World's (materials.hpp, field_problems.hpp).
     BondMaterial m;
-    m.beam_kn = w.settings().contact.kn;
     for_each_field(m, [&](const Field& f, auto& v) { read_option(L, o, f, v); });
-    if (!ks_given) m.beam_ks = m.beam_kn / 10;
     double tolerance = o.number("tolerance", -1);
     const bool stress_free = o.boolean("stress_free", false);
     std::vector<std::int64_t> ids;
     if (o.push("ids") != LUA_TNIL) ids = ids_arg(L, lua_gettop(L), w, ctx.c_str());
     lua_pop(L, 1);
     o.finish();
-    if (m.breakable && !st_given)
-      throw Error(ctx + ": give tensile_strength = (Pa), or breakable = false for elastic bonds");
     lua_pushinteger(L, static_cast<lua_Integer>(w.install_bonds(m, tolerance, ids, stress_free)));
     return 1;
   });
@@ -73,8 +66,6 @@ int world_set_bond_strength(lua_State* L) {
     const auto cs = o.number("contact_shear_strength");
     const auto mub = o.number("contact_bond_friction");
     o.finish();
-    if (breakable && !st)
-      throw Error("world:set_bond_strength: give tensile_strength = (Pa), or breakable = false");
     w.set_bond_strength(st ? *st : 0.0, breakable, c, cs, mub);
     return 0;
   });
@@ -186,11 +177,11 @@ int world_break_count(lua_State* L) {
 const char* install_bonds_help() {
   static const std::string text =
       "Bonds (contact + parallel bond, model.md 5) between every pair closer than tolerance\n"
-      "(default 1e-3 mean radius); beam_kn defaults to the world's kn, beam_ks to beam_kn/10;\n"
-      "ids (a list or predicate) restricts them to pairs of those particles. Existing contact\n"
-      "forces are kept; stress_free = true unloads each contact bond at its current overlap\n"
-      "instead (a contact left by a break keeps that rest overlap until the pair separates).\n"
-      "The material's fields (the C++ struct's default, beam_kn and beam_ks as said above: meaning):" + bond_material_fields_help();
+      "(default 1e-3 mean radius); ids (a list or predicate) restricts them to pairs of those\n"
+      "particles. Existing contact forces are kept; stress_free = true unloads each contact bond\n"
+      "at its current overlap instead (a contact left by a break keeps that rest overlap until the\n"
+      "pair separates). A breakable bond needs tensile_strength.\n"
+      "The material's fields (default: meaning):" + bond_material_fields_help();
   return text.c_str();
 }
 

@@ -23,7 +23,8 @@ struct ContactMaterial {
 
 // Contact bond + parallel bond installed together (model.md 5). The beam of radius
 // Rb = radius_factor * min(Ra, Rb) acts as springs of stiffness kbn A = beam_kn and kbs A = beam_ks
-// (defaults: as stiff as the contact springs, kbs = kbn / 10). The two break separately: the
+// (0, the default: as stiff as the world's contact springs, kbn A = kn, and kbs = kbn / 10; the
+// world installs the bonds with these values). The two break separately: the
 // beam by the elliptic criterion, the contact bond when its tensile normal force or its shear
 // force reaches c st A (PFC's contact bond, Fcn = Fcs = c st A, A the beam's area), where
 // c = contact_strength; c = inf: it never breaks; c = 0: it breaks with the beam (the pair
@@ -32,8 +33,8 @@ struct ContactMaterial {
 // with the compression the contact bond carries, Mohr-Coulomb fashion: Fcs = cs st A + mu_b Fn
 // for Fn > 0 (mu_b = contact_bond_friction; 0, the default, is model.md 5's contact bond).
 struct BondMaterial {
-  double beam_kn = 0.1;            // kbn * A, N/m
-  double beam_ks = 0.01;           // kbs * A, N/m
+  double beam_kn = 0.0;            // kbn * A, N/m; 0: the world's contact kn
+  double beam_ks = 0.0;            // kbs * A, N/m; 0: beam_kn / 10
   double radius_factor = 1.0;      // lambda
   double tensile_strength = 0.0;   // st, Pa (elliptic criterion [3-46..3-49])
   bool breakable = true;           // false: the elastic model (bonds never break)
@@ -58,13 +59,14 @@ void for_each_field(Material& m, Visit&& visit)
 }
 
 // visit(field, member) for each field of a bond material (checked when bonds are installed, read
-// by the Lua binding, saved by a checkpoint). A breakable bond also needs tensile_strength > 0.
+// by the Lua binding, saved by a checkpoint). A breakable bond also needs tensile_strength > 0
+// (bond_material_problem, field_problems.hpp: the rule between two fields).
 template <class Material, class Visit>
   requires std::is_same_v<std::remove_const_t<Material>, BondMaterial>
 void for_each_field(Material& m, Visit&& visit) {
   constexpr double inf = std::numeric_limits<double>::infinity();
-  visit(Field{"beam_kn", "beam_kn", 1, {0, inf, true, true, nullptr, "N/m"}, "kbn A, N/m"}, m.beam_kn);
-  visit(Field{"beam_ks", "beam_ks", 1, {0, inf, true, true, nullptr, "N/m"}, "kbs A, N/m"}, m.beam_ks);
+  visit(Field{"beam_kn", "beam_kn", 1, {0, inf, true, true, "the world's contact kn", "N/m"}, "kbn A, N/m"}, m.beam_kn);
+  visit(Field{"beam_ks", "beam_ks", 1, {0, inf, true, true, "beam_kn / 10", "N/m"}, "kbs A, N/m"}, m.beam_ks);
   visit(Field{"radius_factor", "radius_factor", 1, {0, inf, true, true}, "lambda: Rb = lambda min(Ra, Rb) [3-26]"},
         m.radius_factor);
   visit(Field{"tensile_strength", "tensile_strength", 1, {0, inf, false, true, nullptr, "Pa"},

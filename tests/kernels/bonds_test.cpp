@@ -935,18 +935,33 @@ TEST(Bonds, ABadBondMaterialIsRefusedByNameAndNothingIsInstalled) {
   BondMaterial bad;
   bad.beam_kn = -1;
   bad.tensile_strength = 1;
-  EXPECT_EQ(error_of(bad), "bond material: beam_kn -1 outside (0, inf) N/m");
+  EXPECT_EQ(error_of(bad), "install_bonds: bond material: beam_kn -1 must be 0 (the world's contact kn) or in (0, inf) N/m");
   bad = BondMaterial{};
   bad.radius_factor = 0;
   bad.breakable = false;
-  EXPECT_EQ(error_of(bad), "bond material: radius_factor 0 outside (0, inf)");
+  EXPECT_EQ(error_of(bad), "install_bonds: bond material: radius_factor 0 outside (0, inf)");
   bad = BondMaterial{};
-  EXPECT_NE(error_of(bad).find("a breakable bond needs tensile_strength > 0"), std::string::npos);
+  EXPECT_EQ(error_of(bad), "install_bonds: a breakable bond needs tensile_strength > 0 (Pa), got 0: give it, or "
+                           "breakable = false for unbreakable bonds");
   EXPECT_EQ(w.bond_count(), 0u);
   BondMaterial good;
   good.breakable = false;
   EXPECT_EQ(w.install_bonds(good), 1u);
   BondMaterial other = good;
-  other.beam_ks *= 2;
+  other.beam_ks = 0.05;
   EXPECT_NE(error_of(other).find("one bond material per world"), std::string::npos);
+  // The beam's stiffness left at 0 is the contact springs' (model.md 5): kbn A = kn, kbs = kbn / 10,
+  // whether given so or left to the default, so the two are one material.
+  BondMaterial explicit_stiffness = good;
+  explicit_stiffness.beam_kn = w.settings().contact.kn;
+  explicit_stiffness.beam_ks = w.settings().contact.kn / 10;
+  EXPECT_EQ(error_of(explicit_stiffness), "(no error)");
+  WorldSettings stiff;
+  stiff.contact.kn = 3.0;
+  World v(stiff);
+  v.add_particle({0, 0, 0}, kR);
+  v.add_particle({0, 0, 2 * kR}, kR);
+  ASSERT_EQ(v.install_bonds(good), 1u);
+  EXPECT_EQ(v.state().bonds.material.beam_kn, 3.0);
+  EXPECT_EQ(v.state().bonds.material.beam_ks, 0.3);
 }

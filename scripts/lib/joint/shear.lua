@@ -39,12 +39,10 @@ local function normal_control(run, resumed)
                                  servo = {target_force = target_stress * area, max_velocity = P.servo_max_velocity * P.velocity,
                                           relaxation = P.servo_relaxation,
                                           integral_time = P.servo_integral_steps * world:dt()}})
-  elseif P.normal_control == "load" then
+  else  -- "load" (joint.lua's parameter table admits no other)
     world:set_group_motion(top, {translation = modes, velocity = shear_velocity, damping = P.platen_damping})
     run.applied_z = -target_stress * area
     world:set_group_force(top, {0, 0, run.applied_z})
-  else
-    error("normal_control must be servo, load or stiffness, got '" .. P.normal_control .. "'")
   end
   -- Let the platen settle on the target load before shearing.
   local hold = {table.unpack(modes)}
