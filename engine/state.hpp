@@ -76,8 +76,8 @@ inline std::size_t pair_block_size(std::size_t total) {
 }
 
 // A per-pair or per-bond record array this large is taken to be past the caches: the pair kernel
-// writes it with non-temporal stores (kernels/pairs.cpp) and the gather prefetches it
-// (kernels/integrate.cpp); both pay only where the records do not stay in cache.
+// writes it with non-temporal stores (stages/pairs.cpp) and the gather prefetches it
+// (stages/integrate.cpp); both pay only where the records do not stay in cache.
 inline bool records_past_caches(const AVec<double>& records) {
   return records.size() * sizeof(double) > (std::size_t(4) << 20);
 }
@@ -141,7 +141,7 @@ struct Caches {
   Incidence bond_incidence;
   std::vector<std::int32_t> partner_start, partners;
   // The particles holding a bond the step computes (frozen ones aside): the bond stage checks
-  // their angular velocities each step (kernels/bonds.cpp, bond_stage).
+  // their angular velocities each step (stages/bonds.cpp, bond_stage).
   std::vector<std::int32_t> bonded_particles;
   // Whether a particle spins (an angular velocity other than +0) as the last step left them: the
   // bits of wx, wy, wz ORed over the particles a pair can reach (not inert), and over the ones
@@ -154,7 +154,7 @@ struct Caches {
   std::uint64_t spin_reachable = 0, spin_bonded = 0;
   // Every bond's beam moments are +-0 (set by a scan in refresh_bond_topology, cleared by a bond
   // stage that runs with spin): only spin makes them grow, so the bond stage may take the kernel
-  // that neither carries nor stores them (kernels/bonds.cpp).
+  // that neither carries nor stores them (stages/bonds.cpp).
   bool bond_moments_zero = false;
   // Some bond lost its beam or its contact bond (BondStore::holds): the bond kernel reads what
   // holds; else every bond holds both and the column is not read. Set by refresh_bond_topology.
@@ -164,7 +164,7 @@ struct Caches {
   bool bond_records_with_moments = true;
   // Fewer than half the pair records were live when the pair kernel last counted them
   // (PairStore::live_current): the kernel flags them and the gather skips the dead ones
-  // (kernels/pairs.cpp). Kept here: a neighbour build replaces the pair store.
+  // (stages/pairs.cpp). Kept here: a neighbour build replaces the pair store.
   bool pair_records_sparse = false;
   // Pairs joining two different bodies (group / group or group / free particle) of the current
   // pair list, for the servo's per-step stiffness; valid while `rebuilds` equals group_pairs_at.

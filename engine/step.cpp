@@ -19,11 +19,11 @@
 #include "step.hpp"
 // The stages, in the order a step runs them:
 #include "neighbor/build.hpp"    // 1
-#include "kernels/pairs.hpp"     // 2
+#include "stages/pairs.hpp"     // 2
 #include "kernels/bond_law.hpp"
-#include "kernels/bonds.hpp"     // 3
-#include "kernels/walls.hpp"     // 4
-#include "kernels/integrate.hpp" // 5 + 7
+#include "stages/bonds.hpp"     // 3
+#include "stages/walls.hpp"     // 4
+#include "stages/integrate.hpp" // 5 + 7
 #include "bodies/groups.hpp"     // 6
 
 namespace asperity::detail {

@@ -15,8 +15,9 @@
 #include "field_problems.hpp"
 #include "bodies/mesh.hpp"
 #include "kernels/bond_law.hpp"
-#include "kernels/bonds.hpp"
+#include "stages/bonds.hpp"
 #include "neighbor/build.hpp"
+#include "neighbor/topology.hpp"
 #include "state.hpp"
 #include "step.hpp"
 

@@ -34,10 +34,10 @@
 #include "core/aligned.hpp"
 #include "kernels/kernels.hpp"
 #include "lattice_scene.hpp"
-#include "kernels/bonds.hpp"
-#include "kernels/integrate.hpp"
-#include "kernels/pairs.hpp"
-#include "kernels/walls.hpp"
+#include "stages/bonds.hpp"
+#include "stages/integrate.hpp"
+#include "stages/pairs.hpp"
+#include "stages/walls.hpp"
 #include "neighbor/build.hpp"
 #include "state.hpp"
 #include "step.hpp"
@@ -91,8 +91,8 @@ void bm_neighbors(benchmark::State& st, int edge, int threads) {
   set_counters(st, w.particle_count(), w.stats().pairs);
 }
 
-// A list kernel over `total` entries in the engine's blocks of kPairBlock (as kernels/pairs.cpp
-// and kernels/bonds.cpp run it), timed with `threads` threads.
+// A list kernel over `total` entries in the engine's blocks of kPairBlock (as stages/pairs.cpp
+// and stages/bonds.cpp run it), timed with `threads` threads.
 template <class Kernel, class Args>
 void time_blocks(benchmark::State& st, int threads, Kernel kernel, const Args& k, std::size_t total) {
   const std::size_t blocks = (total + kPairBlock - 1) / kPairBlock;

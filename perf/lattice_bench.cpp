@@ -24,10 +24,10 @@
 #include <utility>
 
 #include "lattice_scene.hpp"
-#include "kernels/bonds.hpp"
-#include "kernels/integrate.hpp"
-#include "kernels/pairs.hpp"
-#include "kernels/walls.hpp"
+#include "stages/bonds.hpp"
+#include "stages/integrate.hpp"
+#include "stages/pairs.hpp"
+#include "stages/walls.hpp"
 #include "neighbor/build.hpp"
 #include "state.hpp"
 #include "step.hpp"

@@ -12,7 +12,7 @@
 #include <Eigen/Dense>
 
 #include "bodies/groups.hpp"
-#include "kernels/bonds.hpp"
+#include "stages/bonds.hpp"
 #include "state.hpp"
 
 namespace asperity::detail {

@@ -11,7 +11,7 @@
 namespace asperity::detail {
 
 // Closest point on triangle (a, b, c) to p; `feature`: 0 face, 1..3 vertex a, b, c, 4..6 edge ab,
-// bc, ca. Defined in kernels/walls.cpp, in the unit of its hottest caller.
+// bc, ca. Defined in stages/walls.cpp, in the unit of its hottest caller.
 Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
                                int& feature);
 // bodies/mesh.cpp: the mesh's edge neighbours (Mesh::edge_neighbour) and its grid of triangles

@@ -1,5 +1,5 @@
 // The size of the last-level cache this process's first CPU sees, for choices that depend on
-// whether a working set fits (kernels/pairs.cpp: non-temporal record stores). Read once from
+// whether a working set fits (stages/pairs.cpp: non-temporal record stores). Read once from
 // /sys/devices/system/cpu/cpu0/cache (the highest level listed); 32 MB where it cannot be read.
 // Not sysconf(_SC_LEVEL3_CACHE_SIZE): in a virtual machine it can report the host's total over
 // all its L3s instead of the one the guest sees.

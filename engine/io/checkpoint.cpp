@@ -20,8 +20,9 @@
 #include "bodies/mesh.hpp"
 #include "field_problems.hpp"
 #include "io/hdf5_file.hpp"
-#include "kernels/bonds.hpp"
+#include "stages/bonds.hpp"
 #include "neighbor/build.hpp"
+#include "neighbor/topology.hpp"
 #include "state.hpp"
 
 namespace asperity {

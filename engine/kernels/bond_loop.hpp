@@ -101,7 +101,7 @@ BondSums bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) 
       Lanes::store(k.mbn + i, s.mbn);
       Lanes::store(k.mbsx + i, s.mbsx); Lanes::store(k.mbsy + i, s.mbsy); Lanes::store(k.mbsz + i, s.mbsz);
     }
-    // For the gather (kernels/integrate.cpp), with the operations it would do per side: the
+    // For the gather (stages/integrate.cpp), with the operations it would do per side: the
     // record fx fy fz U cx cy cz 0 mx my mz 0 of each bond (store/bonds.hpp).
     const T ftot = fn + s.fbn;
     const T sx = s.fsx + s.fbsx, sy = s.fsy + s.fbsy, sz = s.fsz + s.fbsz;

@@ -97,7 +97,7 @@ using BondKernel = BondSums (*)(const BondKernelArgs&, std::size_t begin, std::s
 // Plane wall kernel (wall_loop.hpp): ball-plane contacts [begin, end) of the wall contact list,
 // all of them with planes; the plane is body a of the contact law (model.md 4), translating with
 // its velocity, not spinning. Reads the contacts' history and writes their new state, and per
-// contact the slip energy; the per-wall sums stay with the caller (kernels/walls.cpp), which adds
+// contact the slip energy; the per-wall sums stay with the caller (stages/walls.cpp), which adds
 // them in contact order. The wall columns (px .. friction) are indexed by wall number; px..pz is
 // the plane's current point (its point at creation plus its displacement).
 struct PlaneWallArgs {
@@ -129,7 +129,7 @@ using PlaneWallKernel = void (*)(const PlaneWallArgs&, std::size_t begin, std::s
 // - then, where a bond list is given, the same from the bond records (store/bonds.hpp) plus the
 //   beam moment (+M on b, -M on a), added to those sums;
 // written to fx..tz[i] (the pairs' arguments name the columns). The walls and applied forces are
-// added by the caller (kernels/integrate.cpp).
+// added by the caller (stages/integrate.cpp).
 struct GatherArgs {
   const std::int32_t* start;  // incidence CSR (store/pairs.hpp, Incidence)
   const std::int64_t* entry;  // (pair or bond << 1) | (particle is b)
@@ -140,7 +140,7 @@ struct GatherArgs {
   double* tx; double* ty; double* tz;
   // Prefetch the records of the particle kGatherAhead ahead (vector gathers only, gather_loop.hpp):
   // for record arrays past the caches, whose lines the incidences reach out of order
-  // (kernels/integrate.cpp, records_past_caches in state.hpp).
+  // (stages/integrate.cpp, records_past_caches in state.hpp).
   bool prefetch = false;
   // Pair lists: per pair, 0 where its record is zero but for the overlap (PairKernelArgs::live,
   // from this step's pair kernel); the gather skips those records.

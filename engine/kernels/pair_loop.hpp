@@ -42,7 +42,7 @@ inline void store_pair(const PairKernelArgs& k, std::size_t i, const T& nx, cons
   if (k.rest) Lanes::store(k.rest + i, select(U > T(0.0), u0, T(0.0)));
   Lanes::store(k.nx + i, nx); Lanes::store(k.ny + i, ny); Lanes::store(k.nz + i, nz);
   Lanes::store(k.fsx + i, fx); Lanes::store(k.fsy + i, fy); Lanes::store(k.fsz + i, fz);
-  // For the gather (kernels/integrate.cpp), with the operations it would do per side, and for
+  // For the gather (stages/integrate.cpp), with the operations it would do per side, and for
   // the readers of fn and U: the record fx fy fz U cx cy cz fn of each pair (store/pairs.hpp).
   // fn and U have no columns of their own to store to.
   if (keep_record) return;

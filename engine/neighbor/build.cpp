@@ -32,10 +32,9 @@
 
 #include "bodies/groups.hpp"
 #include "bodies/mesh.hpp"
-#include "kernels/bonds.hpp"
 #include "neighbor/build.hpp"
+#include "neighbor/topology.hpp"
 #include "state.hpp"
-#include "step.hpp"
 
 namespace asperity::detail {
 
@@ -412,7 +411,7 @@ void build_wall_contacts(State& s) {
       // A free particle's triangles of a still mesh within R + skin/2 (Wall::candidates_within_
       // half_skin): one farther away stays farther than R while the particle and the wall close at
       // most skin/2 (the rebuild rule), so the wall stage would skip it at every step until the
-      // next build (kernels/walls.cpp, the same rounding margin). Dropping it changes no bit.
+      // next build (stages/walls.cpp, the same rounding margin). Dropping it changes no bit.
       const double near_reach = (p.radius[i] + 0.5 * s.skin) * (1 + 1e-9);
       for (std::size_t w = 0; w < walls.size(); ++w) {
         const Wall& wall = walls[w];

@@ -46,13 +46,13 @@ struct PairStore {
   AVec<double> out;
   // Per stage of kTouchStage pairs: how many of its records the last pair stage found live
   // (kernels.hpp, PairKernelArgs::touched); 1 where not known. Chooses how the kernel computes
-  // the stage, and (summed: kernels/pairs.cpp) whether it writes the live flags.
+  // the stage, and (summed: stages/pairs.cpp) whether it writes the live flags.
   static constexpr std::size_t kTouchStage = 128;
   std::vector<std::uint8_t> touched;
   // Per pair: 1 where its record is live (not all zeros but for the overlap), written by the pair
   // kernel where live_written (kernels.hpp, PairKernelArgs::live) for the gather in the same step.
   std::vector<std::uint8_t> live;
-  bool live_written = false;  // this step's pair kernel writes `live` (kernels/pairs.cpp)
+  bool live_written = false;  // this step's pair kernel writes `live` (stages/pairs.cpp)
   // `live` and `touched` hold the flags and per-stage counts of the last pair kernel's run.
   bool live_current = false;
   // Set by the pair stage: the current normal forces and overlaps are in the records (slots 7

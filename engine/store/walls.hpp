@@ -41,7 +41,7 @@ struct Mesh {
 
   // Its arrays past the caches (4 MB, as records_past_caches in state.hpp; a thesis-scale mould
   // is, a 2 cm one is not). The wall stage then prefetches the triangles of the contacts it will
-  // evaluate, which pays only where they do not stay in cache (kernels/walls.cpp).
+  // evaluate, which pays only where they do not stay in cache (stages/walls.cpp).
   bool past_caches() const {
     const std::size_t bytes = vertices.size() * sizeof(Vec3) + triangles.size() * sizeof(triangles[0]) +
                               owns.size() + (vertex_start.size() + vertex_triangles.size() + edge_neighbour.size()) * sizeof(std::int32_t);
@@ -74,7 +74,7 @@ struct WallContacts {
   std::vector<double> nx, ny, nz, fsx, fsy, fsz, fn, overlap;
   std::vector<double> slip;  // slip energy of the last step (plane contacts; an output only)
   // Mesh candidates: the distance from the particle's centre to the triangle when the list was
-  // built, which bounds it from below until the next build (kernels/walls.cpp); 0 where unknown
+  // built, which bounds it from below until the next build (stages/walls.cpp); 0 where unknown
   // (a list loaded or re-sorted without it), which never skips a candidate.
   std::vector<double> distance;
   std::vector<std::int32_t> start;  // per particle offsets (CSR), particles + 1

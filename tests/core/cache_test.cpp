@@ -1,5 +1,5 @@
 // The last-level cache size read from /sys (core/cache.hpp), which decides whether the pair
-// records are streamed past the caches (kernels/pairs.cpp).
+// records are streamed past the caches (stages/pairs.cpp).
 #include <gtest/gtest.h>
 
 #include "core/cache.hpp"

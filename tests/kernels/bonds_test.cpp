@@ -107,7 +107,7 @@ TEST(Bonds, BendingStressIsFourMOverPiRCubed) {
 }
 
 // While no bonded particle turns and every beam moment is zero, the bond stage takes the kernel
-// that leaves the moments alone (kernels/bonds.cpp). Once a turn has bent the beam, a step without
+// that leaves the moments alone (stages/bonds.cpp). Once a turn has bent the beam, a step without
 // spin must still carry the moment and pass it to the particles.
 TEST(Bonds, BeamMomentStillActsAfterTheTurningStops) {
   BondMaterial bm;
@@ -192,7 +192,7 @@ TEST(Bonds, CompressedBondFailsOnlyAtTenTimesTheStrength) {
 }
 
 // A broken bond's pair enters the contact list in the step that breaks it, without a neighbour
-// rebuild (a fracture run breaks bonds on most of its steps; kernels/bonds.cpp, process_breaks),
+// rebuild (a fracture run breaks bonds on most of its steps; stages/bonds.cpp, process_breaks),
 // and the contact it leaves acts from the next step on with the contact law's force.
 TEST(Bonds, ABreakListsTheFreedPairWithoutARebuild) {
   BondMaterial bm;
@@ -531,7 +531,7 @@ TEST(Bonds, CriticalStepIncludesTheBondAndBondedRotationIsLocked) {
   EXPECT_THROW(w.set_angular_velocity(a, {1, 0, 0}), Error) << "locked while bonded";
 }
 
-// The rotation lock under damage (model.md 2, kernels/bonds.cpp refresh_bond_topology): a particle
+// The rotation lock under damage (model.md 2, stages/bonds.cpp refresh_bond_topology): a particle
 // none of whose bonds broke is locked however few it holds; a damaged one while it holds
 // rotation_lock_bonds. A star (centre with four bonds) and an arm (two bonds) lose bonds to
 // neighbours pulled away.

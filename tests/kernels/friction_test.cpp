@@ -96,7 +96,7 @@ TEST(Friction, SetFrictionChangesTheBallBallSlipLimit) {
 
 TEST(Friction, ASpinningSphereShearsItsContactInTheFirstStep) {
   // The pair stage leaves the spin terms out when no particle a pair can reach turns
-  // (kernels/pairs.cpp); a spin set through the API must still drive the law's relative velocity
+  // (stages/pairs.cpp); a spin set through the API must still drive the law's relative velocity
   // at once: A turns about x at w, B rests on it along z, so at the contact point
   // V = -la (wA x n) = (0, la w, 0) and the first step's shear force on B is -ks V dt [3-19].
   // An inert spinning particle far away (never in a pair) must not matter either way, nor a crowd

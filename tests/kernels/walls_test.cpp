@@ -107,7 +107,7 @@ TEST(Walls, FoldedMeshPushesFromBothFaces) {
 
 // The wall stage skips a mesh candidate that cannot touch yet: its distance at the neighbour
 // build, less how far the particle and the mesh have moved since, is above the radius
-// (kernels/walls.cpp). A sphere pressed onto a fine flat mesh and slid across it (or the mesh
+// (stages/walls.cpp). A sphere pressed onto a fine flat mesh and slid across it (or the mesh
 // slid under it) reaches triangles it did not touch at the build several times between builds;
 // each must take the contact over the step it is reached, or the sphere loses its support for a
 // step and drops by ~F dt^2 / m (~1e-5 m here). So its height stays at R - F / kn throughout.

@@ -184,7 +184,7 @@ TEST(Determinism, SameSeedSameRun) {
 // The same on a whole run: a bonded box (its listed pairs mostly near misses, and contacts left
 // by breaking stress-free bonds, with rest overlaps) stepped once with the live flags written and
 // the dead records skipped at every step, once with them only at the probing steps (every 64th,
-// kernels/pairs.cpp), gives the same positions bit for bit and the same breaks; left to itself
+// stages/pairs.cpp), gives the same positions bit for bit and the same breaks; left to itself
 // the engine finds the box sparse and skips.
 TEST(Determinism, SkippingDeadPairRecordsLeavesARunBitwiseTheSame) {
   struct Result {

@@ -9,7 +9,7 @@
 
 #include "bodies/mesh.hpp"
 #include "kernels/contact_law.hpp"
-#include "kernels/walls.hpp"
+#include "stages/walls.hpp"
 #include "state.hpp"
 
 namespace asperity::detail {

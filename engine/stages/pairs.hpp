@@ -1,4 +1,4 @@
-// Stage 2 of a step: ball-ball contact forces (kernels/pairs.cpp).
+// Stage 2 of a step: ball-ball contact forces (stages/pairs.cpp).
 #pragma once
 #include "state.hpp"
 

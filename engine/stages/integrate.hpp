@@ -1,5 +1,5 @@
 // Stage 5 of a step: the forces gathered per particle and the free particles moved
-// (kernels/integrate.cpp).
+// (stages/integrate.cpp).
 #pragma once
 #include "state.hpp"
 

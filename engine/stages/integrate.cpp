@@ -15,7 +15,7 @@
 // same).
 #include <cmath>
 
-#include "kernels/integrate.hpp"
+#include "stages/integrate.hpp"
 #include "state.hpp"
 
 namespace asperity::detail {
@@ -54,7 +54,7 @@ StageLoop integrate_stage(State& s) {
                                 p.fy.data(), p.fz.data(), p.tx.data(), p.ty.data(),
                                 p.tz.data()};
   // Pair records the pair kernel flagged dead (zero forces) are skipped where it flagged them
-  // this step (kernels/pairs.cpp, GatherArgs::live).
+  // this step (stages/pairs.cpp, GatherArgs::live).
   if (q.live_written) pair_args.live = q.live.data();
   kernels::GatherArgs bond_args = pair_args;
   bond_args.live = nullptr;
@@ -79,7 +79,7 @@ StageLoop integrate_stage(State& s) {
   const std::int32_t* wparticle = wc.particle.data();
   auto add_wall = [=](std::int32_t k) __attribute__((always_inline)) {
     // A candidate that does not touch holds zero forces (a plane's kernel selects them, a mesh
-    // candidate is skipped or zeroed, kernels/walls.cpp): adding them would change at most the
+    // candidate is skipped or zeroed, stages/walls.cpp): adding them would change at most the
     // sign of a zero sum. A particle near a mould has ~40 candidates and touches one to three.
     if (!(wu[k] > 0)) return;
     const std::size_t i = std::size_t(wparticle[k]);

@@ -7,7 +7,7 @@
 #include <cstdint>
 
 #include "core/cache.hpp"
-#include "kernels/pairs.hpp"
+#include "stages/pairs.hpp"
 #include "state.hpp"
 
 namespace asperity::detail {

@@ -1,4 +1,4 @@
-// Stage 4 of a step: ball-wall contact forces (kernels/walls.cpp).
+// Stage 4 of a step: ball-wall contact forces (stages/walls.cpp).
 #pragma once
 #include "state.hpp"
 

@@ -1,5 +1,5 @@
 // Stage 3 of a step: bond forces and breaks; and the bond list's whole life (installed, broken,
-// frozen inside rigid bodies, removed), in one place (kernels/bonds.cpp).
+// frozen inside rigid bodies, removed), in one place (stages/bonds.cpp).
 #pragma once
 #include <cstdint>
 #include <span>
@@ -16,7 +16,6 @@ std::size_t install_bonds(State& s, const BondMaterial& material, double toleran
 void remove_bonds(State& s);  // every bond, no events, no energy booked
 kernels::BondKernelArgs bond_kernel_args(State& s);  // its kernel's arguments (perf/ reuses them)
 void process_breaks(State& s);         // events, energy, compaction
-void refresh_bond_topology(State& s);  // incidence, partners, rotation locks
 // Moves the bonds inside lazy groups (Group::lazy, set by the caller) to State::frozen_bonds and
 // the others back; true if any moved (the topology is then refreshed).
 bool settle_frozen_bonds(State& s);
