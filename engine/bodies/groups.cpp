@@ -348,6 +348,11 @@ void split_idle(State& s) {
       p.tx[i] = p.ty[i] = p.tz[i] = 0;
     }
   }
+  index_moved(s);
+}
+
+void index_moved(State& s) {
+  const ParticleStore& p = s.p;
   const std::size_t blocks = (p.n + kParticleBlock - 1) / kParticleBlock;
   s.cache.block_free.assign(blocks, 0);
   for (std::size_t i = 0; i < p.n; ++i)

@@ -17,5 +17,6 @@ GroupStages group_stages(State& s);     // empty stages without groups
 void update_servo_stiffness(State& s);  // every step while a servo acts
 void sync_lazy(State& s);               // bring inert and idle members up to date
 void split_idle(State& s);              // busy / idle members of lazy groups
+void index_moved(State& s);             // the split's indexes by block and slot, from idle and busy
 
 }  // namespace asperity::detail

@@ -30,7 +30,7 @@ namespace asperity {
 namespace {
 
 using detail::State;
-constexpr int kCheckpointVersion = 10;  // 2: servo integral and integral time, group damping;
+constexpr int kCheckpointVersion = 11;  // 2: servo integral and integral time, group damping;
                                        // 3: rest overlaps (stress-free bonds);
                                        // 4: meshes' candidates within half the skin;
                                        // 5: a header with a checksum in the HDF5 user block;
@@ -39,7 +39,9 @@ constexpr int kCheckpointVersion = 10;  // 2: servo integral and integral time, 
                                        // 8: overlap_limit;
                                        // 9: contact bonds apart from the beam (what holds,
                                        //    contact_strength, the kind of a break);
-                                       // 10: the groups' impulse (a resumed run's interval means)
+                                       // 10: the groups' impulse (a resumed run's interval means);
+                                       // 11: the lazy groups' idle split and pending shift, so that
+                                       //     saving does not bring idle members up to date
 
 // The file's kind in the header of its HDF5 user block (io::h5::file_image), whose checksum is
 // verified before HDF5 parses the file: HDF5 does not survive every corruption of its metadata.
@@ -227,8 +229,8 @@ void visit(Io& io, State& s) {
     q->size_outputs();
   }
 
-  // Bonds: one list, active and frozen together (the first step after loading freezes the same
-  // ones again: State::frozen_bonds).
+  // Bonds: one list, active and frozen together (loading freezes the same ones again, or the
+  // first step's split does: State::frozen_bonds).
   detail::BondStore every;
   if constexpr (std::is_same_v<Io, Writer>) {
     if (s.frozen_bonds.n > 0) every = detail::all_bonds(s);
@@ -338,7 +340,21 @@ void visit(Io& io, State& s) {
   detail::WallContacts::history_columns(
       [&](const detail::ColumnInfo& c, auto& col) { visit_column(io, "wall_contacts/", c, col, wc.n); }, wc);
 
-  // Rigid groups.
+  // Rigid groups, and the idle split of the lazy ones (bodies/groups.cpp, split_idle): saved as it
+  // is, with the shift not yet applied to the idle members, because bringing them up to date at
+  // the save would round their moves differently from the run that was not saved.
+  if (io.version >= 11) {
+    io.flag("run/idle_valid", s.cache.idle_valid);
+    io.column("run/idle", s.cache.idle);
+    // What the last step left for the next one's choice of kernels (State::spin_known ...): a
+    // resumed run takes the kernels the unbroken one takes.
+    io.flag("run/spin_known", s.cache.spin_known);
+    io.scalar("run/spin_reachable", s.cache.spin_reachable);
+    io.scalar("run/spin_bonded", s.cache.spin_bonded);
+    io.flag("run/bond_moments_zero", s.cache.bond_moments_zero);
+    io.flag("run/bond_records_with_moments", s.cache.bond_records_with_moments);
+    io.flag("run/pair_records_sparse", s.cache.pair_records_sparse);
+  }
   io.count("groups/n", s.groups);
   for (std::size_t g = 0; g < s.groups.size(); ++g) {
     auto& grp = s.groups[g];
@@ -358,6 +374,13 @@ void visit(Io& io, State& s) {
     io.vec(at + "/force", grp.force);
     io.vec(at + "/torque", grp.torque);
     if (io.version >= 10) io.vec(at + "/impulse", grp.impulse);
+    if (io.version >= 11) {
+      io.flag(at + "/lazy", grp.lazy);
+      io.column(at + "/busy", grp.busy);
+      io.vec(at + "/idle_shift", grp.idle_shift);
+      io.scalar(at + "/idle_mass", grp.idle_mass);
+      io.scalar(at + "/idle_base", grp.idle_base);
+    }
     GroupMotion& m = grp.motion;
     std::vector<std::uint8_t> modes{std::uint8_t(m.translation[0]), std::uint8_t(m.translation[1]),
                                     std::uint8_t(m.translation[2]), std::uint8_t(m.rotation)};
@@ -507,6 +530,7 @@ void validate(const State& s, const std::string& path) {
          "wall_contacts/start");
   need(s.need_rebuild || wc.start.empty() || wc.start.size() == n + 1, "wall_contacts/start");
 
+  need(!s.cache.idle_valid || s.cache.idle.size() == n, "run/idle");
   // Groups: members and inert members partition the particles that name the group.
   std::vector<std::size_t> named(s.groups.size(), 0);
   for (std::size_t i = 0; i < n; ++i)
@@ -521,6 +545,13 @@ void validate(const State& s, const std::string& path) {
              "group " + std::to_string(g) + " members");
       }
     need(grp.members.size() + grp.inert.size() == named[g], "group " + std::to_string(g) + " members");
+    // The idle split: busy members are members, in order; the idle flags cover the particles.
+    for (std::size_t k = 0; k < grp.busy.size(); ++k) {
+      const auto i = grp.busy[k];
+      need(i >= 0 && std::size_t(i) < n && p.group[std::size_t(i)] == std::int32_t(g) && (k == 0 || grp.busy[k - 1] < i),
+           "group " + std::to_string(g) + " busy members");
+    }
+    need(finite3(grp.idle_shift) && finite(grp.idle_mass) && finite(grp.idle_base), "group " + std::to_string(g) + " idle state");
     need(grp.mass > 0 && finite(grp.mass) && finite(grp.inert_mass) && finite(grp.contact_stiffness) &&
              finite3(grp.centre) && finite3(grp.velocity) && finite3(grp.angular_velocity) &&
              finite3(grp.applied) && finite3(grp.force) && finite3(grp.torque) && finite3(grp.inert_shift) &&
@@ -549,7 +580,6 @@ void World::save(const std::string& path) const {
     Writer w{h, path};
     int version = kCheckpointVersion;
     w.scalar("asperity_checkpoint_version", version);
-    detail::sync_lazy(const_cast<State&>(*state_));  // idle members to where they are (not observable)
     visit(w, const_cast<State&>(*state_));  // the writer only reads (and fills the fn and U columns from the records)
     image = io::h5::file_image(h, path, kMagic);
   }
@@ -586,7 +616,23 @@ World World::load(const std::string& path, int threads, const std::string& simd)
   s.p.capacity = s.p.x.size();
   for (auto& mesh : s.walls.meshes) detail::bin_mesh(mesh);
   detail::build_incidence(s.p.n, s.pairs.a.data(), s.pairs.b.data(), s.pairs.n, s.incidence);
-  detail::refresh_bond_topology(s);
+  {
+    // The bond topology is derived; the kernel choices saved with it are kept (version 11).
+    const auto c = s.cache;
+    // With the idle split saved, the bonds inside the lazy groups leave the step now, as they had
+    // in the saved run (the file holds one list; without a split the first step does this).
+    if (s.cache.idle_valid) detail::settle_frozen_bonds(s);
+    detail::refresh_bond_topology(s);
+    if (version >= 11) {
+      s.cache.spin_known = c.spin_known;
+      s.cache.spin_reachable = c.spin_reachable;
+      s.cache.spin_bonded = c.spin_bonded;
+      s.cache.bond_moments_zero = c.bond_moments_zero;
+      s.cache.bond_records_with_moments = c.bond_records_with_moments;
+      s.cache.pair_records_sparse = c.pair_records_sparse;
+    }
+  }
+  if (s.cache.idle_valid) detail::index_moved(s);  // the saved split's indexes
   return world;
 }
 

@@ -1,5 +1,6 @@
 // Module-level functions of `asperity`: JSON, HDF5 read-back, directories, plots of arrays,
 // clocks, version information.
+#include <filesystem>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -149,6 +150,19 @@ int l_mkdir(lua_State* L) {
   });
 }
 
+int l_remove_all(lua_State* L) {
+  return guarded(L, [&] {
+    const std::string path = check_string(L, 1);
+    if (path.empty() || path == "/" || path == "." || path == "..")
+      throw ArgError{1, "refusing to remove '" + path + "'"};
+    std::error_code ec;
+    const auto n = std::filesystem::remove_all(path, ec);
+    if (ec) throw Error("asperity.remove_all: cannot remove '" + path + "': " + ec.message());
+    lua_pushinteger(L, static_cast<lua_Integer>(n));
+    return 1;
+  });
+}
+
 // A column for plotting from an Array or a table of numbers.
 io::Column column_from(lua_State* L, int index, const std::string& label, const char* what) {
   std::size_t cols = 1;
@@ -254,6 +268,9 @@ void open_io(lua_State* L) {
       {"h5_attribute", l_h5_attribute, "asperity.h5_attribute(path, object, name) -> value or nil",
        "An attribute (\"/\" for the file's own), e.g. h5_attribute(f, \"/time\", \"units\")."},
       {"mkdir", l_mkdir, "asperity.mkdir(path) -> path", "Creates a directory and its parents if needed."},
+      {"remove_all", l_remove_all, "asperity.remove_all(path) -> n",
+       "Removes a file, or a directory and everything in it (n: entries removed; 0 if there was\n"
+       "nothing)."},
       {"plot", l_plot,
        "asperity.plot{file=, x=, y= [, labels=] [, xlabel=] [, ylabel=] [, title=] [, logx=]\n"
        "  [, logy=] [, points=]} -> file",

@@ -31,6 +31,24 @@ void read_option(lua_State* L, Options& o, const Field& f, ContactMaterial& v);
 const char* dof_name(Dof d);  // "free", "fixed", "velocity", "servo"
 // The help lines of the servo's, the bond material's and a group motion's fields, from their tables.
 std::string servo_fields_help();
+// A row (ContactInfo, BondInfo, BreakEvent) as a table, field by field from its table
+// (for_each_info, world.hpp): ids from 1, vectors as vec, modes and kinds by name.
+inline void push_info_value(lua_State* L, double v) { lua_pushnumber(L, v); }
+inline void push_info_value(lua_State* L, bool v) { lua_pushboolean(L, v); }
+inline void push_info_value(lua_State* L, std::int64_t id) { lua_pushinteger(L, static_cast<lua_Integer>(id + 1)); }
+inline void push_info_value(lua_State* L, std::uint64_t n) { lua_pushinteger(L, static_cast<lua_Integer>(n)); }
+inline void push_info_value(lua_State* L, const Vec3& v) { push_vec(L, v); }
+inline void push_info_value(lua_State* L, BreakEvent::Mode m) { lua_pushstring(L, name_of(m)); }
+inline void push_info_value(lua_State* L, BreakEvent::Kind k) { lua_pushstring(L, name_of(k)); }
+template <class Row>
+void push_row(lua_State* L, const Row& row) {
+  lua_createtable(L, 0, 16);
+  for_each_info(row, [&](const char* name, const auto& v) {
+    push_info_value(L, v);
+    lua_setfield(L, -2, name);
+  });
+}
+
 std::string bond_material_fields_help();
 std::string motion_fields_help();
 // Particles named by a list of ids (table or Array) or by a predicate function(id, pos, r).

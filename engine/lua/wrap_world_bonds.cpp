@@ -14,19 +14,6 @@ namespace {
 // ---------------------------------------------------------------------------------------------
 // Bonds
 
-const char* break_mode_name(BreakEvent::Mode m) {
-  switch (m) {
-    case BreakEvent::Mode::tension: return "tension";
-    case BreakEvent::Mode::compression: return "compression";
-    case BreakEvent::Mode::shear: return "shear";
-  }
-  return "?";
-}
-
-const char* break_kind_name(BreakEvent::Kind k) {
-  return k == BreakEvent::Kind::beam ? "beam" : "contact_bond";
-}
-
 int world_install_bonds(lua_State* L) {
   return guarded(L, [&] {
     World& w = world_arg(L);
@@ -90,28 +77,7 @@ int world_bonds(lua_State* L) {
     std::vector<BondInfo> bs = world_arg(L).bonds();
     lua_createtable(L, static_cast<int>(bs.size()), 0);
     for (std::size_t k = 0; k < bs.size(); ++k) {
-      const BondInfo& b = bs[k];
-      lua_createtable(L, 0, 12);
-      auto num = [&](const char* f, double v) { lua_pushnumber(L, v); lua_setfield(L, -2, f); };
-      auto vec = [&](const char* f, const Vec3& v) { push_vec(L, v); lua_setfield(L, -2, f); };
-      lua_pushinteger(L, b.id_a + 1);
-      lua_setfield(L, -2, "a");
-      lua_pushinteger(L, b.id_b + 1);
-      lua_setfield(L, -2, "b");
-      vec("normal", b.normal);
-      vec("point", b.point);
-      num("gap", b.gap);
-      num("beam_radius", b.beam_radius);
-      num("normal_force", b.normal_force);
-      vec("shear_force", b.shear_force);
-      num("twisting_moment", b.twisting_moment);
-      vec("bending_moment", b.bending_moment);
-      num("sigma", b.sigma);
-      num("tau", b.tau);
-      lua_pushboolean(L, b.beam);
-      lua_setfield(L, -2, "beam");
-      lua_pushboolean(L, b.contact_bond);
-      lua_setfield(L, -2, "contact_bond");
+      push_row(L, bs[k]);
       lua_rawseti(L, -2, static_cast<lua_Integer>(k + 1));
     }
     return 1;
@@ -127,28 +93,7 @@ int world_break_events(lua_State* L) {
     lua_createtable(L, 0, 0);
     lua_Integer k = 0;
     for (std::size_t i = static_cast<std::size_t>(first - 1); i < events.size(); ++i) {
-      const BreakEvent& e = events[i];
-      lua_createtable(L, 0, 9);
-      lua_pushinteger(L, static_cast<lua_Integer>(e.step));
-      lua_setfield(L, -2, "step");
-      lua_pushnumber(L, e.time);
-      lua_setfield(L, -2, "time");
-      push_vec(L, e.position);
-      lua_setfield(L, -2, "position");
-      lua_pushinteger(L, e.id_a + 1);
-      lua_setfield(L, -2, "a");
-      lua_pushinteger(L, e.id_b + 1);
-      lua_setfield(L, -2, "b");
-      lua_pushstring(L, break_mode_name(e.mode));
-      lua_setfield(L, -2, "mode");
-      lua_pushstring(L, break_kind_name(e.kind));
-      lua_setfield(L, -2, "kind");
-      lua_pushnumber(L, e.sigma);
-      lua_setfield(L, -2, "sigma");
-      lua_pushnumber(L, e.tau);
-      lua_setfield(L, -2, "tau");
-      lua_pushnumber(L, e.released_energy);
-      lua_setfield(L, -2, "released_energy");
+      push_row(L, events[i]);
       lua_rawseti(L, -2, ++k);
     }
     return 1;
@@ -166,7 +111,7 @@ int world_break_count(lua_State* L) {
     std::size_t n = events.size();
     if (kind != "all") {
       n = 0;
-      for (const BreakEvent& e : events) n += kind == break_kind_name(e.kind);
+      for (const BreakEvent& e : events) n += kind == name_of(e.kind);
     }
     lua_pushinteger(L, static_cast<lua_Integer>(n));
     return 1;

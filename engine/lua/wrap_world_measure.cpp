@@ -60,22 +60,7 @@ int world_contacts(lua_State* L) {
     std::vector<ContactInfo> cs = world_arg(L).contacts();
     lua_createtable(L, static_cast<int>(cs.size()), 0);
     for (std::size_t k = 0; k < cs.size(); ++k) {
-      const ContactInfo& c = cs[k];
-      lua_createtable(L, 0, 7);
-      lua_pushinteger(L, c.id_a + 1);
-      lua_setfield(L, -2, "a");
-      lua_pushinteger(L, c.id_b + 1);
-      lua_setfield(L, -2, "b");
-      push_vec(L, c.normal);
-      lua_setfield(L, -2, "normal");
-      push_vec(L, c.point);
-      lua_setfield(L, -2, "point");
-      lua_pushnumber(L, c.overlap);
-      lua_setfield(L, -2, "overlap");
-      lua_pushnumber(L, c.normal_force);
-      lua_setfield(L, -2, "normal_force");
-      push_vec(L, c.shear_force);
-      lua_setfield(L, -2, "shear_force");
+      push_row(L, cs[k]);
       lua_rawseti(L, -2, static_cast<lua_Integer>(k + 1));
     }
     return 1;

@@ -249,6 +249,63 @@ struct BreakEvent {  // model.md 5: every break
   double released_energy;     // strain energy of the part that was not kept by a contact, J
 };
 
+// The fields of a contact's, a bond's and a break's row, by the names users read them under
+// (world:contacts(), world:bonds(), world:break_events() in Lua), in one table each: the Lua
+// binding writes its rows from these, so a new field is declared in its struct, listed here and
+// filled where the row is made. std::int64_t fields are particle ids (Lua counts them from 1).
+template <class Row, class Visit>
+  requires std::is_same_v<std::remove_const_t<Row>, ContactInfo>
+void for_each_info(Row& c, Visit&& visit) {
+  visit("a", c.id_a);
+  visit("b", c.id_b);
+  visit("normal", c.normal);
+  visit("point", c.point);
+  visit("overlap", c.overlap);
+  visit("normal_force", c.normal_force);
+  visit("shear_force", c.shear_force);
+}
+template <class Row, class Visit>
+  requires std::is_same_v<std::remove_const_t<Row>, BondInfo>
+void for_each_info(Row& b, Visit&& visit) {
+  visit("a", b.id_a);
+  visit("b", b.id_b);
+  visit("normal", b.normal);
+  visit("point", b.point);
+  visit("gap", b.gap);
+  visit("beam_radius", b.beam_radius);
+  visit("normal_force", b.normal_force);
+  visit("shear_force", b.shear_force);
+  visit("twisting_moment", b.twisting_moment);
+  visit("bending_moment", b.bending_moment);
+  visit("sigma", b.sigma);
+  visit("tau", b.tau);
+  visit("beam", b.beam);
+  visit("contact_bond", b.contact_bond);
+}
+template <class Row, class Visit>
+  requires std::is_same_v<std::remove_const_t<Row>, BreakEvent>
+void for_each_info(Row& e, Visit&& visit) {
+  visit("step", e.step);
+  visit("time", e.time);
+  visit("position", e.position);
+  visit("a", e.id_a);
+  visit("b", e.id_b);
+  visit("mode", e.mode);
+  visit("kind", e.kind);
+  visit("sigma", e.sigma);
+  visit("tau", e.tau);
+  visit("released_energy", e.released_energy);
+}
+inline const char* name_of(BreakEvent::Mode m) {
+  switch (m) {
+    case BreakEvent::Mode::tension: return "tension";
+    case BreakEvent::Mode::compression: return "compression";
+    case BreakEvent::Mode::shear: return "shear";
+  }
+  return "?";
+}
+inline const char* name_of(BreakEvent::Kind k) { return k == BreakEvent::Kind::beam ? "beam" : "contact_bond"; }
+
 struct Energies {            // model.md 8; all in J
   double kinetic = 0;        // translational + rotational
   double strain = 0;         // stored in the contact springs and bonds

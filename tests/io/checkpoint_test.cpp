@@ -1,4 +1,5 @@
 // Checkpoints: a run restarted from a checkpoint continues bit for bit.
+#include <algorithm>
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -102,6 +103,67 @@ TEST(Checkpoint, RestartContinuesBitForBit) { restart_continues_bit_for_bit(fals
 
 // The rest overlaps of stress-free bonds and of the contacts their breaks leave are saved too.
 TEST(Checkpoint, RestartWithStressFreeBondsContinuesBitForBit) { restart_continues_bit_for_bit(true); }
+
+// Saving changes nothing of the run that saves, so a run resumed from a save is the run that was
+// never interrupted: a block on a plane whose lower layers form a platen driven sideways (its
+// rotation fixed: the members that touch only each other are idle, moved lazily), saved between
+// two neighbour builds with the idle members' shift pending, runs on as a twin never saved does,
+// and as the world loaded from the save does.
+TEST(Checkpoint, SavingChangesNothingOfTheRun) {
+  auto scene = [](World& w) {
+    const double r = 1e-3;
+    std::vector<std::int64_t> platen;
+    for (int k = 0; k < 6; ++k)
+      for (int j = 0; j < 6; ++j)
+        for (int i = 0; i < 6; ++i) {
+          const double jitter = 1e-6 * ((i * 7 + j * 13 + k * 29) % 11);
+          const auto id = w.add_particle({2 * r * i + jitter, 2 * r * j, r + 1.999 * r * k}, r);
+          if (k < 4) platen.push_back(id);
+        }
+    w.add_plane({0, 0, 0}, {0, 0, 1});
+    // Bonded, so the platen holds bonds inside it (left out of the step while it does not turn,
+    // State::frozen_bonds), some between a busy member and an idle one.
+    BondMaterial bm;
+    bm.breakable = false;
+    ASSERT_GT(w.install_bonds(bm, 2.5e-6), 0u);
+    GroupMotion m;
+    m.translation = {Dof::velocity, Dof::fixed, Dof::fixed};
+    m.velocity = {2e-3, 0, 0};
+    w.add_group(platen, m);
+    w.cycle(300);
+  };
+  WorldSettings ws;
+  ws.dt = 2e-4;
+  World w(ws), u(ws);
+  scene(w);
+  scene(u);
+  ASSERT_GT(w.state().frozen_bonds.n, 0u) << "the scene needs bonds inside the platen";
+  ASSERT_TRUE(w.state().groups[0].lazy);
+  const auto& idle = w.state().cache.idle;
+  ASSERT_TRUE(std::any_of(idle.begin(), idle.end(), [](auto f) { return f != 0; })) << "the scene needs idle members";
+  // A step after which the idle members' shift is pending (no build at it).
+  while (w.state().groups[0].idle_shift == Vec3{}) {
+    w.cycle(1);
+    u.cycle(1);
+  }
+  const std::string path = temp_file("asperity_checkpoint_test_saving.h5");
+  w.save(path);
+  World r = World::load(path, 1, w.simd_architecture());
+  for (World* x : {&w, &u, &r}) x->cycle(1);
+  // The platen's force (what a servo or a load cell reads) at the first step after the load.
+  EXPECT_EQ(w.group_force(0), u.group_force(0));
+  EXPECT_EQ(r.group_force(0), u.group_force(0));
+  for (World* x : {&w, &u, &r}) x->cycle(2000);
+  EXPECT_EQ(r.group_force(0), u.group_force(0));
+  EXPECT_GT(w.state().rebuilds, 1u);
+  EXPECT_TRUE(same(w.positions(), u.positions())) << "saving changed the run";
+  EXPECT_TRUE(same(w.velocities(), u.velocities()));
+  EXPECT_TRUE(same(r.positions(), u.positions())) << "the loaded world parts from the run it was saved from";
+  EXPECT_TRUE(same(r.forces(), u.forces()));
+  EXPECT_EQ(r.state().rebuilds, u.state().rebuilds);
+  EXPECT_EQ(r.energies().boundary_work, u.energies().boundary_work);
+  std::filesystem::remove(path);
+}
 
 TEST(Checkpoint, MissingOrForeignFileIsAClearError) {
   EXPECT_THROW(World::load("/nonexistent/x.h5"), Error);

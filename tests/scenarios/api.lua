@@ -78,6 +78,16 @@ local sampled = {}
 n = w:run{steps = 70, every = 50, sample_every = 20, sample = function(w) sampled[#sampled + 1] = w:step() end}
 assert(n == 70 and #sampled == 3 and sampled[1] == 540 and sampled[3] == 580, "samples at " .. table.concat(sampled, " "))
 assert(w:cycle(5) == 5 and w:step() == 595)
+do  -- asperity.remove_all: a folder and what it holds; nothing there is not an error
+  local dir = os.tmpname()
+  os.remove(dir)
+  asperity.mkdir(dir .. "/sub")
+  local f = io.open(dir .. "/sub/file", "w"); f:write("x"); f:close()
+  assert(asperity.remove_all(dir) == 3 and not io.open(dir .. "/sub/file"), "remove_all")
+  assert(asperity.remove_all(dir) == 0)
+  local ok, err = pcall(asperity.remove_all, "/")
+  assert(not ok and err:find("refusing to remove '/'", 1, true), err)
+end
 do  -- a run resumed with steps_done: the cap and the cadences count on from there (checks at 40,
     -- 50 of the run; samples at 48, 60), so 595 + 17 steps end a run of 60 begun 43 steps earlier
   local checks, samples = {}, {}

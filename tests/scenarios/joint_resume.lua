@@ -94,6 +94,12 @@ assert(wait_for(other, 120) ~= 0, "a resume with other parameters must fail")
 assert(log_text():find("holds a run saved with stress=14, not 21", 1, true), "the refusal names the parameter:\n" .. log_text())
 assert(read(dir .. "/.resume/state.lua") == state, "the refused run leaves the state as it was")
 
+-- What a save cut short leaves (a temporary file of the world's in the new folder, one in the
+-- current folder from an earlier cut) does not stop the next saves.
+for _, junk in ipairs{dir .. "/.resume.new/world.h5.tmp", dir .. "/.resume/world.h5.tmp"} do
+  asperity.mkdir(junk:match("^(.*)/"))
+  local f = io.open(junk, "w"); f:write("cut short"); f:close()
+end
 pid, status = start(dir, every)
 wait_log("resumed from [^\n]*closure phase", 1, status)
 local shear_saves = count(log_text(), "%(shear%)")

@@ -22,9 +22,10 @@ local M = {}
 
 local VERSION = 1
 -- Parameters that change how a run is carried out but not what it computes (the results do not
--- depend on the thread count): a resumed run may give others.
+-- depend on the thread count), and where it is (a run folder may be moved): a resumed run may give
+-- others.
 local FREE = {threads = true, genesis_threads = true, progress = true, checkpoint_every = true, cache = true,
-              save = true}
+              save = true, out = true}
 -- The run's fields (joint/context.lua) that the closure and the shear change and the report reads.
 local RUN_FIELDS = {"ramp_steps", "moved_steps", "overlap_max", "overlap_at", "escaped_count", "escape_box",
                     "z_contact", "normal_stiffness", "applied_z", "axis", "c0", "e0", "dynamic_ratio",
@@ -42,11 +43,8 @@ local function read(path)
   return text
 end
 
-local function remove_state(path)
-  os.remove(path .. "/world.h5")
-  os.remove(path .. "/state.lua")
-  os.remove(path)
-end
+-- A state's folder, whole (a save cut short may have left a temporary file in it).
+local function remove_state(path) asperity.remove_all(path) end
 
 -- The parameters that shape the results, as text, for the comparison on resume.
 local function signature(P)
@@ -116,8 +114,10 @@ function Checkpoint:save(part)
   local f = assert(io.open(new_dir .. "/state.lua", "wb"))
   assert(f:write(text))
   assert(f:close())
+  -- The swap: the current state becomes .old (a folder without a state is what a cut save left:
+  -- it goes), the new one takes its place, then .old goes.
   remove_state(old_dir)
-  if read(final .. "/state.lua") then assert(os.rename(final, old_dir)) end
+  if read(final .. "/state.lua") then assert(os.rename(final, old_dir)) else remove_state(final) end
   assert(os.rename(new_dir, final))
   remove_state(old_dir)
   self.saves = self.saves + 1
@@ -143,7 +143,7 @@ function M.find(run)
       local now = signature(P)
       local names = {}
       for k in pairs(now) do names[#names + 1] = k end
-      for k in pairs(state.parameters) do if now[k] == nil then names[#names + 1] = k end end
+      for k in pairs(state.parameters) do if now[k] == nil and not FREE[k] then names[#names + 1] = k end end
       table.sort(names)
       for _, k in ipairs(names) do
         if now[k] ~= state.parameters[k] then
