@@ -40,6 +40,14 @@ inline void push_info_value(lua_State* L, std::uint64_t n) { lua_pushinteger(L, 
 inline void push_info_value(lua_State* L, const Vec3& v) { push_vec(L, v); }
 inline void push_info_value(lua_State* L, BreakEvent::Mode m) { lua_pushstring(L, name_of(m)); }
 inline void push_info_value(lua_State* L, BreakEvent::Kind k) { lua_pushstring(L, name_of(k)); }
+// "{a, b, normal, ...}": a row's fields by their table, for help texts.
+template <class Row>
+std::string row_fields() {
+  std::string out = "{";
+  const Row row{};
+  for_each_info(row, [&](const char* name, const auto&) { out += (out.size() > 1 ? ", " : "") + std::string(name); });
+  return out + "}";
+}
 template <class Row>
 void push_row(lua_State* L, const Row& row) {
   lua_createtable(L, 0, 16);

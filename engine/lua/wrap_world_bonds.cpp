@@ -160,6 +160,11 @@ int bond_criterion(lua_State* L) {
 }
 
 std::span<const Function> world_bond_methods() {
+  static const std::string bonds_help = "Bonds of which a part holds: " + row_fields<BondInfo>() +
+                                        ";\nbeam and contact_bond say which part holds (model.md 5: they break separately).";
+  static const std::string breaks_help =
+      "Bond breaks so far (from number `first`): " + row_fields<BreakEvent>() +
+      ";\nkind is \"beam\" (the parallel bond) or \"contact_bond\", mode \"tension\", \"compression\" or \"shear\".";
   static const Function methods[] = {
       {"install_bonds", world_install_bonds,
        "world:install_bonds{tensile_strength= | breakable=false [, beam_kn=] [, beam_ks=]\n"
@@ -178,14 +183,8 @@ std::span<const Function> world_bond_methods() {
        "Deletes every bond (no break events; bonded pairs become ordinary contacts)."},
       {"save", world_save, "world:save(path)",
        "Writes a checkpoint (the whole state, HDF5); asperity.load(path) continues bit for bit."},
-      {"bonds", world_bonds, "world:bonds() -> {bond, ...}",
-       "Bonds of which a part holds: {a, b, normal, point, gap, beam_radius, normal_force,\n"
-       "shear_force, twisting_moment, bending_moment, sigma, tau, beam, contact_bond}; beam and\n"
-       "contact_bond say which part holds (model.md 5: they break separately)."},
-      {"break_events", world_break_events, "world:break_events([first]) -> {event, ...}",
-       "Bond breaks so far (from number `first`): {step, time, position, a, b, kind, mode, sigma,\n"
-       "tau, released_energy}; kind is \"beam\" (the parallel bond) or \"contact_bond\", mode\n"
-       "\"tension\", \"compression\" or \"shear\"."},
+      {"bonds", world_bonds, "world:bonds() -> {bond, ...}", bonds_help.c_str()},
+      {"break_events", world_break_events, "world:break_events([first]) -> {event, ...}", breaks_help.c_str()},
       {"break_count", world_break_count, "world:break_count([kind]) -> n",
        "Breaks so far of kind \"beam\" (the default: parallel bonds, the thesis's broken bonds),\n"
        "\"contact_bond\", or \"all\" (the numbering of world:break_events)."},

@@ -81,6 +81,7 @@ int world_contact_count(lua_State* L) {
 }  // namespace
 
 std::span<const Function> world_measure_methods() {
+  static const std::string contacts_help = "Touching ball-ball pairs: " + row_fields<ContactInfo>() + ".";
   static const Function methods[] = {
       {"energies", world_energies, "world:energies() -> table",
        "kinetic, strain (now), friction, damping, boundary_work, gravity_work, released\n"
@@ -90,8 +91,7 @@ std::span<const Function> world_measure_methods() {
       {"unbalanced_force_ratio", world_unbalanced_force_ratio, "world:unbalanced_force_ratio() -> r",
        "Mean unbalanced force of the particles outside rigid groups / mean normal force of the\n"
        "touching contacts, wall contacts and intact bonds (PFC's equilibrium ratio)."},
-      {"contacts", world_contacts, "world:contacts() -> {contact, ...}",
-       "Touching ball-ball pairs: {a, b, normal, point, overlap, normal_force, shear_force}."},
+      {"contacts", world_contacts, "world:contacts() -> {contact, ...}", contacts_help.c_str()},
       {"contact_count", world_contact_count, "world:contact_count() -> n", "Touching ball-ball pairs."},
       {"max_overlap_ratio", world_max_overlap_ratio, "world:max_overlap_ratio() -> r",
        "Deepest overlap (touching pairs, wall contacts, bonds) / radius of the smaller body; 0 if none.\n"

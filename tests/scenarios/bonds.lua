@@ -62,4 +62,11 @@ assert(not ok and tostring(err):find('"beam", "contact_bond" or "all"'), tostrin
 ok, err = pcall(w2.set_bond_strength, w2, {tensile_strength = st, contact_strength = -1})
 assert(not ok and tostring(err):find("contact_strength"), tostring(err))
 w2:set_bond_strength{tensile_strength = st, contact_strength = math.huge}  -- never breaks from now on
+-- Rows carry the fields their help lists (both from one table, for_each_info in world.hpp), and
+-- each field is set.
+local function keys(row) local t = {}; for k in pairs(row) do t[#t + 1] = k end; table.sort(t); return table.concat(t, ",") end
+local bond_keys = keys(w2:bonds()[1])
+assert(bond_keys == "a,b,beam,beam_radius,bending_moment,contact_bond,gap,normal,normal_force,point,shear_force,sigma,tau,twisting_moment",
+       bond_keys)
+assert(keys(w2:break_events()[1]) == "a,b,kind,mode,position,released_energy,sigma,step,tau,time", keys(w2:break_events()[1]))
 print("PASS")
