@@ -17,6 +17,7 @@
 -- again on resume: the genesis comes from the specimen cache, and the assembly and the model
 -- from it are deterministic. A kill before the closure starts therefore starts the run again.
 local persist = require("persist")
+local read = require("shell").read
 
 local M = {}
 
@@ -35,13 +36,6 @@ local SERIES = {"closure", "shear"}
 
 local function dir(P) return P.out .. "/.resume" end
 
-local function read(path)
-  local f = io.open(path, "rb")
-  if not f then return nil end
-  local text = f:read("a")
-  f:close()
-  return text
-end
 
 -- A state's folder, whole (a save cut short may have left a temporary file in it).
 local function remove_state(path) asperity.remove_all(path) end
