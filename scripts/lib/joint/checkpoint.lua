@@ -50,7 +50,7 @@ end
 local Checkpoint = {}
 Checkpoint.__index = Checkpoint
 
--- run.checkpoint, saving every `minutes` (0: only on SIGTERM ... and then not: 0 turns it off).
+-- run.checkpoint: saves every checkpoint_every minutes and on SIGTERM; 0 turns both off.
 local function new(run)
   local P = run.P
   return setmetatable({run = run, every = P.checkpoint_every * 60, last = asperity.wall_time(),
