@@ -1,6 +1,6 @@
-// Everything a World holds: the world's data (State), what one step works with (StepContext) and
-// what is derived from the data and redone when it changes (Caches). See engine/step.cpp for the
-// order in which the stages read and write them.
+// Everything a World holds: the world's data (State), what one step works with (StepContext,
+// step_context.hpp) and what is derived from the data and redone when it changes (Caches). See
+// engine/step.cpp for the order of the stages and stages/views.hpp for what each reads and writes.
 #pragma once
 #include <algorithm>
 #include <atomic>
@@ -12,125 +12,13 @@
 #include "core/load.hpp"
 #include "kernels/kernels.hpp"
 #include "store/bonds.hpp"
+#include "store/groups.hpp"
 #include "store/pairs.hpp"
 #include "store/particles.hpp"
 #include "store/walls.hpp"
+#include "step_context.hpp"
 
 namespace asperity::detail {
-
-struct Group {
-  std::vector<std::int32_t> members;  // current particle indices, moved every step
-  std::vector<std::int32_t> inert;    // members moved only when read (see World::set_inert)
-  Vec3 inert_shift{0, 0, 0};          // group displacement not yet applied to the inert members
-  double inert_mass = 0;
-  // A group whose rotation is fixed ("lazy") splits its other members at every neighbour build:
-  // `busy` ones have something acting on them (a pair, bond or wall contact, an applied force) and
-  // are summed and moved every step; the rest are idle (State::idle): their force is zero until
-  // the next build, so they are moved lazily like inert ones: a rigid block then costs its
-  // interface, not its volume. Groups that may rotate keep every member busy.
-  bool lazy = false;
-  std::vector<std::int32_t> busy;
-  Vec3 idle_shift{0, 0, 0};  // displacement not yet applied to the idle members
-  double idle_mass = 0;
-  double idle_base = 0;      // bound on the idle members' displacement since the build, before idle_shift
-  Vec3 servo_origin{0, 0, 0};         // centre when the motion was set (CNS reference)
-  Vec3 servo_integral{0, 0, 0};       // int (F - F_target) dt per servo axis since the motion was set
-  double contact_stiffness = 0;       // summed kn of the members' contacts this step (servo gain)
-  GroupMotion motion;
-  double mass = 0;
-  Vec3 centre, velocity, angular_velocity;
-  Vec3 applied{0, 0, 0};
-  Vec3 force, torque;  // last step: contact + applied on members (torque about the centre)
-  Vec3 impulse{0, 0, 0};  // sum of force x dt since the world was made (time averages)
-};
-
-// A rigid group's motion in the current step, for its members' moves and the ledgers
-// (bodies/groups.cpp, group_stages).
-struct GroupStep {
-  bool moves = false;  // the group has members (its motion was advanced)
-  Vec3 old_centre{0, 0, 0}, centre{0, 0, 0}, velocity{0, 0, 0}, angular_velocity{0, 0, 0};
-  Vec3 mean_angular_velocity{0, 0, 0}, theta{0, 0, 0};
-  bool spins = false;
-  double boundary = 0, damping = 0, gravity = 0;  // its terms of the ledgers
-  double kinetic = 0;                             // of its inert and idle members
-};
-
-// Cumulative ledgers of model.md 8 (kinetic and strain are computed on demand).
-struct Ledger {
-  double friction = 0, damping = 0, boundary = 0, gravity = 0, released = 0;
-};
-
-// Work units: pairs and particles are processed in fixed blocks; per-block partial sums are
-// combined in block order, so sums do not depend on how blocks are spread over threads.
-inline constexpr std::size_t kPairBlock = 1024;      // multiple of kMaxLanes
-inline constexpr std::size_t kParticleBlock = 512;
-// The pair and bond stages' block for a list of `total` entries: kPairBlock, or smaller (down to
-// 256) so that a short list still makes 32 blocks, which two threads can share out evenly by
-// taking each other's last blocks (step.cpp, run_stages); long lists keep the larger blocks,
-// which cost less per entry. A function of the list alone, never of the thread count: the
-// blocks' partial sums are combined in order.
-inline std::size_t pair_block_size(std::size_t total) {
-  constexpr std::size_t stage = PairStore::kTouchStage;  // blocks of whole pair stages
-  const std::size_t want = (total / 32 + stage - 1) / stage * stage;
-  return std::min(kPairBlock, std::max(std::size_t(256), want));
-}
-
-// A per-pair or per-bond record array this large is taken to be past the caches: the pair kernel
-// writes it with non-temporal stores (stages/pairs.cpp) and the gather prefetches it
-// (stages/integrate.cpp); both pay only where the records do not stay in cache.
-inline bool records_past_caches(const AVec<double>& records) {
-  return records.size() * sizeof(double) > (std::size_t(4) << 20);
-}
-
-struct ParticleBlockResult {
-  double damping = 0, gravity = 0, applied = 0;
-  double kinetic = 0;        // at the step's time level: from the mean of old and new velocities
-  double max_disp2 = 0;      // squared displacement since the last build
-  double worst_step = 0;     // max of |v| dt / R and |w| dt / 0.1 rad (1 = health limit)
-  std::int32_t worst = -1;   // its particle index
-  // The block's angular velocities after the stage, bits ORed (State::spin_known): over its
-  // particles that are not inert, and over those that hold a bond the step computes.
-  std::uint64_t spin_reachable = 0, spin_bonded = 0;
-};
-
-// A stage split around its block loop, so that step.cpp runs the loops of the pair, bond and
-// wall stages and then of the gather + integrate stage in one parallel region (run_stages)
-// instead of one region each: every fork and join costs the step a wait of all its threads.
-// `run(blk)` writes only block blk's slots; `finish` sums the blocks in order, so the results are
-// those of separate regions, bit for bit.
-struct StageLoop {
-  std::size_t blocks = 0;
-  bool after_barrier = false;  // its blocks start once every earlier stage's blocks are done
-  std::function<void(std::size_t)> run;
-  std::function<void()> finish;  // may be empty
-};
-
-// What a step works with besides the world's data: the kernels and threads it runs on, and its
-// scratch (per-block partial results, the group stages' member slots), rewritten every step.
-struct StepContext {
-  const kernels::KernelSet* kernels = nullptr;
-  int max_threads = 1;
-  // Automatic threads (settings.threads = 0): the cores other processes leave free, sampled every
-  // half second for the whole process (core/load.hpp, watch_load in step.cpp); 0: not known.
-  LoadWatch* load = &process_load();
-  int load_limit = 0;
-
-  std::vector<double> pair_block_slip;
-  std::vector<double> bond_block_breaks;
-  std::vector<double> bond_block_slip;
-  std::vector<ParticleBlockResult> particle_blocks;
-  // The group stages (bodies/groups.cpp): the members moved every step (busy members of lazy
-  // groups, all members of the others) in slots by group (group g: moved_start[g] to
-  // moved_start[g + 1]) and member order, their slots by particle block (split_idle); per group
-  // its motion in this step, per slot the member's kinetic energy, squared displacement since
-  // the last build and whether its new position is finite.
-  std::vector<std::int32_t> moved_particle;
-  std::vector<std::size_t> moved_start;
-  Incidence block_moved;
-  std::vector<GroupStep> group_steps;
-  std::vector<double> member_kinetic, member_disp2;
-  std::vector<std::uint8_t> member_finite;
-};
 
 // Derived from the world's data and kept between steps because computing them every step costs:
 // each says when it is valid, and what the API changes reaches them through changed() (below).
@@ -166,14 +54,7 @@ struct Caches {
   // (PairStore::live_current): the kernel flags them and the gather skips the dead ones
   // (stages/pairs.cpp). Kept here: a neighbour build replaces the pair store.
   bool pair_records_sparse = false;
-  // Pairs joining two different bodies (group / group or group / free particle) of the current
-  // pair list, for the servo's per-step stiffness; valid while `rebuilds` equals group_pairs_at.
-  // Likewise the bonds joining two bodies (a joint's platens are tied by a few of its many
-  // bonds), valid while the bond list is the one of version group_bonds_of.
-  std::vector<std::uint32_t> group_pairs, group_bonds;
-  std::vector<std::uint32_t> group_bond_ends;  // per group: its ends of group_bonds
-  std::uint64_t group_pairs_at = ~std::uint64_t(0);
-  std::uint64_t group_bonds_of = ~std::uint64_t(0);  // the bond_version they were taken from
+  ServoContacts servo;  // the contacts between bodies, for the servo (store/groups.hpp)
   // Idle group members (see Group::busy), per particle index; valid while idle_valid (the split
   // is redone at every neighbour build and after the API changes motions or applied forces).
   std::vector<std::uint8_t> idle;

@@ -21,10 +21,12 @@
 #include "neighbor/build.hpp"    // 1
 #include "stages/pairs.hpp"     // 2
 #include "kernels/bond_law.hpp"
+#include "bond_list.hpp"
 #include "stages/bonds.hpp"     // 3
 #include "stages/walls.hpp"     // 4
 #include "stages/integrate.hpp" // 5 + 7
-#include "bodies/groups.hpp"     // 6
+#include "stages/groups.hpp"     // 6
+#include "bodies/groups.hpp"
 
 namespace asperity::detail {
 
@@ -113,7 +115,7 @@ void bookkeep(State& s) {
   for (std::size_t gi = 0; gi < s.groups.size(); ++gi) {
     const Group& g = s.groups[gi];
     double d2 = 0;
-    // The moved members in member order, as the moves stage left them (bodies/groups.cpp).
+    // The moved members in member order, as the moves stage left them (stages/groups.cpp).
     for (std::size_t slot = s.ctx.moved_start[gi]; slot < s.ctx.moved_start[gi + 1]; ++slot) {
       d2 = std::max(d2, s.ctx.member_disp2[slot]);
       if (!s.ctx.member_finite[slot]) {
@@ -426,6 +428,40 @@ void watch_load(State& s) {
 // Moved group members from which the group stages run in the step's parallel region.
 constexpr std::size_t kParallelMoves = 512;
 
+namespace {
+Ledger* ledger_if_tracked(State& s) { return s.settings.track_energy ? &s.ledger : nullptr; }
+}  // namespace
+
+PairStageView pair_view(State& s) {
+  return {s.p, s.pairs, s.settings.contact, s.dt, s.step, s.any_rotating, s.rest_overlaps,
+          thread_count(s), s.cache.spin_known, s.cache.spin_reachable,
+          s.cache.pair_records_sparse, s.ctx, ledger_if_tracked(s)};
+}
+
+BondStageView bond_view(State& s) {
+  return {s.p, s.bonds, s.settings.contact, s.dt, s.any_rotating, s.rest_overlaps,
+          s.cache.spin_known, s.cache.spin_bonded, s.cache.bonded_particles,
+          s.cache.bonds_partial, s.cache.bond_moments_zero, s.cache.bond_records_with_moments,
+          s.ctx, ledger_if_tracked(s)};
+}
+
+WallStageView wall_view(State& s) {
+  return {s.p, s.walls, s.dt, s.any_rotating, s.ctx, ledger_if_tracked(s)};
+}
+
+GroupStageView group_view(State& s) {
+  return {s.p, s.groups, s.pairs, s.bonds, s.walls, s.cache.servo, s.rebuilds, s.bond_version,
+          s.settings.contact, s.settings.gravity, s.settings.local_damping, s.dt,
+          s.kinetic_at_step, s.ctx, ledger_if_tracked(s)};
+}
+
+IntegrateStageView integrate_view(State& s) {
+  return {s.p, s.pairs, s.incidence, s.walls.contacts, s.bonds, s.cache.bond_incidence,
+          s.cache.bond_records_with_moments, s.cache.idle, s.cache.block_free,
+          s.cache.block_busy, s.cache.spin_known, s.cache.spin_reachable, s.cache.spin_bonded,
+          s.settings.gravity, s.settings.local_damping, s.dt, s.any_rotating, s.ctx};
+}
+
 void step_once(State& s) {
   watch_load(s);
   const bool rebuilt = s.need_rebuild;
@@ -433,10 +469,10 @@ void step_once(State& s) {
   const bool estimate_due = s.step >= s.last_estimate_step + std::uint64_t(s.settings.dt_interval);
   if (!s.cache.idle_valid) split_idle(s);
   if (rebuilt || estimate_due || s.dt <= 0) check_dt(s);
-  // The three force stages, then gather + integrate, in one parallel region (state.hpp,
+  // The three force stages, then gather + integrate, in one parallel region (step_context.hpp,
   // StageLoop); the ledgers and wall forces are summed after it.
-  StageLoop pairs = pair_stage(s), bonds = bond_stage(s), walls = wall_stage(s),
-            particles = integrate_stage(s);
+  StageLoop pairs = pair_stage(pair_view(s)), bonds = bond_stage(bond_view(s)),
+            walls = wall_stage(wall_view(s)), particles = integrate_stage(integrate_view(s));
   if (s.groups.empty()) {
     run_stages(s, {&pairs, &bonds, &walls, &particles});
     s.kinetic_at_step = 0;  // the particles' share is added in bookkeeping
@@ -444,7 +480,7 @@ void step_once(State& s) {
     // The rigid groups in the same region where many members move (a platen of the elastic
     // joint), so that no thread waits while another moves them. Where few move, their two more
     // barriers would cost more than they save, so those stages run after the region.
-    GroupStages g = group_stages(s);
+    GroupStages g = group_stages(group_view(s));
     if (s.ctx.moved_particle.size() >= kParallelMoves) {
       run_stages(s, {&pairs, &bonds, &walls, &particles, &g.servo, &g.motion, &g.moves});
     } else {  // on one thread, the same sums in the same order as the call above

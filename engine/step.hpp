@@ -2,6 +2,7 @@
 #pragma once
 #include <initializer_list>
 
+#include "stages/views.hpp"
 #include "state.hpp"
 
 namespace asperity::detail {
@@ -20,5 +21,12 @@ struct OverlapRatio {
 OverlapRatio deepest_overlap(const State& s);
 Energies compute_energies(const State& s);
 void watch_load(State& s);  // StepContext::load_limit, for automatic threads
+
+// What each stage reads and writes of the State (stages/views.hpp), as the step hands it out.
+PairStageView pair_view(State& s);
+BondStageView bond_view(State& s);
+WallStageView wall_view(State& s);
+IntegrateStageView integrate_view(State& s);
+GroupStageView group_view(State& s);
 
 }  // namespace asperity::detail

@@ -5,7 +5,7 @@
 #include <algorithm>
 
 #include "kernels/bond_law.hpp"
-#include "stages/bonds.hpp"
+#include "bond_list.hpp"
 #include "state.hpp"
 #include "step.hpp"
 

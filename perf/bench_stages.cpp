@@ -71,10 +71,7 @@ struct SceneCache {
 SceneCache cache;
 
 // One stage on its own, run as the step runs its stages (run_stages).
-void run_stage(State& s, StageLoop (*stage)(State&)) {
-  StageLoop st = stage(s);
-  run_stages(s, {&st});
-}
+void run_stage(State& s, StageLoop st) { run_stages(s, {&st}); }
 
 void set_counters(benchmark::State& st, std::size_t particles, std::size_t pairs) {
   st.counters["particle_steps"] =
@@ -113,7 +110,7 @@ void bm_pair(benchmark::State& st, int edge, int threads, std::string simd) {
   World& w = cache.get(edge, "pair");
   State& s = w.state();
   const auto& ks = asperity::kernels::select_kernels(simd);
-  time_blocks(st, threads, ks.pair, pair_kernel_args(s), s.pairs.padded);
+  time_blocks(st, threads, ks.pair, pair_kernel_args(pair_view(s)), s.pairs.padded);
   set_counters(st, w.particle_count(), s.pairs.n);
   st.SetLabel(ks.name);
 }
@@ -123,7 +120,7 @@ void bm_bond(benchmark::State& st, int edge, int threads, std::string simd) {
   World& w = cache.get(edge, "bond");
   State& s = w.state();
   const auto& ks = asperity::kernels::select_kernels(simd);
-  time_blocks(st, threads, s.any_rotating ? ks.bond : ks.bond_norot, bond_kernel_args(s),
+  time_blocks(st, threads, s.any_rotating ? ks.bond : ks.bond_norot, bond_kernel_args(bond_view(s)),
               s.bonds.padded);
   set_counters(st, w.particle_count(), 0);
   st.counters["bonds"] =
@@ -135,7 +132,7 @@ void bm_walls(benchmark::State& st, int edge, int threads) {
   World& w = cache.get(edge, "walls");
   w.set_threads(threads);
   State& s = w.state();
-  for (auto _ : st) run_stage(s, wall_stage);
+  for (auto _ : st) run_stage(s, wall_stage(wall_view(s)));
   set_counters(st, w.particle_count(), 0);
   st.counters["wall_contacts"] = double(s.walls.contacts.n);
 }
@@ -144,7 +141,7 @@ void bm_gather(benchmark::State& st, int edge, int threads) {
   World& w = cache.get(edge, "gather");
   w.set_threads(threads);
   State& s = w.state();
-  for (auto _ : st) run_stage(s, integrate_stage);
+  for (auto _ : st) run_stage(s, integrate_stage(integrate_view(s)));
   set_counters(st, w.particle_count(), s.pairs.n);
 }
 

@@ -56,9 +56,7 @@ std::pair<double, double> time_per_call(F&& f, int calls) {
 }
 
 // One stage on its own, run as the step runs its stages (run_stages).
-void run_stage(asperity::detail::State& s,
-               asperity::detail::StageLoop (*stage)(asperity::detail::State&)) {
-  asperity::detail::StageLoop st = stage(s);
+void run_stage(asperity::detail::State& s, asperity::detail::StageLoop st) {
   asperity::detail::run_stages(s, {&st});
 }
 
@@ -144,9 +142,9 @@ int main(int argc, char** argv) {
         sum[k] += cpu ? ct : wall;
       };
       add(0, [&] { w.cycle(1); });
-      add(1, [&] { run_stage(s, pair_stage); });
-      add(2, [&] { run_stage(s, wall_stage); });
-      add(3, [&] { run_stage(s, integrate_stage); });
+      add(1, [&] { run_stage(s, pair_stage(pair_view(s))); });
+      add(2, [&] { run_stage(s, wall_stage(wall_view(s))); });
+      add(3, [&] { run_stage(s, integrate_stage(integrate_view(s))); });
     }
     const double t_step = sum[0] / calls, t_pair = sum[1] / calls, t_wall = sum[2] / calls,
                  t_gi = sum[3] / calls;

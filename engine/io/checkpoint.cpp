@@ -20,7 +20,7 @@
 #include "bodies/mesh.hpp"
 #include "field_problems.hpp"
 #include "io/hdf5_file.hpp"
-#include "stages/bonds.hpp"
+#include "bond_list.hpp"
 #include "neighbor/build.hpp"
 #include "neighbor/topology.hpp"
 #include "state.hpp"

@@ -551,7 +551,7 @@ void insert_pairs(State& s, const PairStore& add) {
   merged.fill_padding(s.p.null_a(), s.p.null_b());
   s.pairs = std::move(merged);
   build_incidence(s.p.n, s.pairs.a.data(), s.pairs.b.data(), s.pairs.n, s.incidence);
-  s.cache.group_pairs_at = ~std::uint64_t(0);  // the servo's list holds pair indices
+  s.cache.servo.pairs_at = ~std::uint64_t(0);  // the servo's list holds pair indices
   s.cache.idle_valid = false;                  // a member may have a pair now
 }
 

@@ -1,28 +1,12 @@
-// Stage 3 of a step: bond forces and breaks; and the bond list's whole life (installed, broken,
-// frozen inside rigid bodies, removed), in one place (stages/bonds.cpp).
+// Stage 3 of a step: bond forces and break flags (stages/bonds.cpp); the breaks and the rest of
+// the bond list's life are bond_list.hpp.
 #pragma once
-#include <cstdint>
-#include <span>
-
-#include "state.hpp"
+#include "stages/views.hpp"
 
 namespace asperity::detail {
 
-StageLoop bond_stage(State& s);
-// Bonds between the chosen particles (all when `ids` is empty) at most `tolerance` apart, merged
-// into the bond list (material, tolerance and ids checked by the caller); returns how many.
-std::size_t install_bonds(State& s, const BondMaterial& material, double tolerance,
-                          std::span<const std::int64_t> ids, bool stress_free);
-void remove_bonds(State& s);  // every bond, no events, no energy booked
-kernels::BondKernelArgs bond_kernel_args(State& s);  // its kernel's arguments (perf/ reuses them)
-void process_breaks(State& s);         // events, energy, compaction
-// Moves the bonds inside lazy groups (Group::lazy, set by the caller) to State::frozen_bonds and
-// the others back; true if any moved (the topology is then refreshed).
-bool settle_frozen_bonds(State& s);
-// Every bond, active and frozen, in one store sorted by (a, b) (checkpoints).
-BondStore all_bonds(const State& s);
-// x and y (each sorted by (a, b), no bond in both) in one store sorted by (a, b); its material
-// and `any` are left to the caller.
-BondStore merge_bonds(const BondStore& x, const BondStore& y);
+StageLoop bond_stage(const BondStageView& s);
+// Its kernel's arguments (perf/ reuses them).
+kernels::BondKernelArgs bond_kernel_args(const BondStageView& s);
 
 }  // namespace asperity::detail

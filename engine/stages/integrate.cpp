@@ -1,7 +1,7 @@
 // Stages `gather` and `integrate`, fused per block of kParticleBlock particles: the gather sums
 // each particle's pair, bond and wall contributions in the fixed order of its incidence lists
 // into fx..tz, then the integrate kernel advances the block with leapfrog and local damping
-// (kernels/integrate_loop.hpp, SIMD; particles of rigid groups are moved by bodies/groups.cpp).
+// (kernels/integrate_loop.hpp, SIMD; particles of rigid groups are moved by stages/groups.cpp).
 // The block's forces are still in L1/L2 when the kernel reads them back.
 //
 // Per-pair results give force and torques without anything else (model.md 4):
@@ -16,23 +16,22 @@
 #include <cmath>
 
 #include "stages/integrate.hpp"
-#include "state.hpp"
 
 namespace asperity::detail {
 
-StageLoop integrate_stage(State& s) {
+StageLoop integrate_stage(const IntegrateStageView& s) {
   ParticleStore& p = s.p;
   const PairStore& q = s.pairs;
   const Incidence& inc = s.incidence;
-  const WallContacts& wc = s.walls.contacts;
+  const WallContacts& wc = s.wall_contacts;
   const BondStore& bq = s.bonds;
-  const Incidence& binc = s.cache.bond_incidence;
+  const Incidence& binc = s.bond_incidence;
   const std::size_t n = p.n;
   const std::size_t blocks = (n + kParticleBlock - 1) / kParticleBlock;
   s.ctx.particle_blocks.assign(blocks, {});
-  const Vec3 g = s.settings.gravity;
+  const Vec3 g = s.gravity;
   const bool applied = p.has_applied;
-  const std::uint8_t* idle = s.cache.idle.data();  // sized p.n by split_idle, which runs before, as are
+  const std::uint8_t* idle = s.idle.data();  // sized p.n by split_idle, which runs before, as are
                                              // block_free and block_busy
   // Blocks in which no particle spins take the kernel without rotation (below).
   const auto integrate = s.any_rotating ? s.ctx.kernels->integrate : s.ctx.kernels->integrate_norot;
@@ -44,7 +43,7 @@ StageLoop integrate_stage(State& s) {
       p.mass.data(), p.inv_mass.data(), p.inertia.data(), p.inv_inertia.data(), p.radius.data(),
       applied ? p.ax.data() : nullptr, applied ? p.ay.data() : nullptr,
       applied ? p.az.data() : nullptr, nullptr, nullptr,
-      s.dt, s.settings.local_damping, g.x, g.y, g.z};
+      s.dt, s.local_damping, g.x, g.y, g.z};
 
   // The pair sums and the bond terms of a range of particles, in one pass (the kernel skips inert
   // and idle ones, as below).
@@ -61,7 +60,7 @@ StageLoop integrate_stage(State& s) {
   bond_args.start = binc.start.data();
   bond_args.entry = binc.entry.data();
   bond_args.records = bq.out.data();
-  bond_args.moments = s.cache.bond_records_with_moments;
+  bond_args.moments = s.bond_records_with_moments;
   // Records past the caches are prefetched a few particles ahead, as the incidences reach their
   // lines out of order; records in cache are not (the prefetches would cost and hide nothing).
   pair_args.prefetch = records_past_caches(q.out);
@@ -110,16 +109,16 @@ StageLoop integrate_stage(State& s) {
   const std::uint8_t* inert = p.inert.data();
   const std::int32_t* group = p.group.data();
   const std::uint8_t* locked = p.rotation_locked.data();
-  // The spin left in particles first..end (State::spin_known), read while their lines are at hand.
+  // The spin left in particles first..end (Caches::spin_known), read while their lines are at hand.
   // Where the last step's answer holds (spin_known), only blocks the kernel with rotation
   // integrated can add to it: the kernel without rotation and the gather write no w, the group
   // stages give members their group's (bookkeep adds it). Once something spins the answer cannot
   // change until it is cleared, so nothing is read then (the lattice, where both say so).
   const ParticleStore* const ps = &p;
   const std::int32_t* bond_start = binc.start.size() > n ? binc.start.data() : nullptr;
-  const bool full = !s.cache.spin_known;  // bookkeep starts the answer afresh then
+  const bool full = !s.spin_known;  // bookkeep starts the answer afresh then
   const bool track =
-      s.any_rotating && (full || s.cache.spin_reachable == 0 || (bq.n > 0 && s.cache.spin_bonded == 0));
+      s.any_rotating && (full || s.spin_reachable == 0 || (bq.n > 0 && s.spin_bonded == 0));
   auto spin_of = [=](std::size_t first, std::size_t end, ParticleBlockResult& r) {
     // Branch-free (all-ones masks), so that the loops vectorise.
     auto bits = [=](std::size_t i) { return ps->spin_bits(i); };
@@ -140,13 +139,13 @@ StageLoop integrate_stage(State& s) {
   StageLoop st;
   st.blocks = blocks;
   st.after_barrier = true;  // the forces of every stage before it are needed
-  st.run = [=, &s](std::size_t blk) {
+  st.run = [=](std::size_t blk) {
     ParticleBlockResult r;
-    if (!s.cache.block_free[blk]) {
+    if (!s.block_free[blk]) {
       // Rigid-group members only: their forces feed the group sums; nothing to integrate, and
       // only the busy members (split_idle) have any.
-      for (std::int32_t e = s.cache.block_busy.start[blk]; e < s.cache.block_busy.start[blk + 1]; ++e)
-        gather(std::size_t(s.cache.block_busy.entry[e]));
+      for (std::int32_t e = s.block_busy.start[blk]; e < s.block_busy.start[blk + 1]; ++e)
+        gather(std::size_t(s.block_busy.entry[e]));
       if (track && full) spin_of(blk * kParticleBlock, std::min(n, (blk + 1) * kParticleBlock), r);
       s.ctx.particle_blocks[blk] = r;
       return;
@@ -170,7 +169,7 @@ StageLoop integrate_stage(State& s) {
     int spins = 0;
     for (std::size_t i = first; i < end; ++i) {
       // Only free particles are integrated: inert and idle ones move lazily with their group,
-      // other members with it (bodies/groups.cpp). Without branches (`&`, not `&&`): in a joint
+      // other members with it (stages/groups.cpp). Without branches (`&`, not `&&`): in a joint
       // the flags vary from particle to particle, and branches on them would be mispredicted.
       const int moves = int(inert[i] == 0) & int(idle[i] == 0) & int(group[i] < 0);
       const int turns = moves & int(locked[i] == 0);

@@ -8,14 +8,13 @@
 
 #include "core/cache.hpp"
 #include "stages/pairs.hpp"
-#include "state.hpp"
 
 namespace asperity::detail {
 
-kernels::PairKernelArgs pair_kernel_args(State& s) {
-  ParticleStore& p = s.p;
+kernels::PairKernelArgs pair_kernel_args(const PairStageView& s) {
+  const ParticleStore& p = s.p;
   PairStore& q = s.pairs;
-  const ContactMaterial& m = s.settings.contact;
+  const ContactMaterial& m = s.contact;
   return {p.x.data(), p.y.data(), p.z.data(), p.vx.data(), p.vy.data(), p.vz.data(),
           p.wx.data(), p.wy.data(), p.wz.data(), p.radius.data(), q.a.data(), q.b.data(),
           q.nx.data(), q.ny.data(), q.nz.data(), q.fsx.data(), q.fsy.data(), q.fsz.data(),
@@ -33,11 +32,11 @@ namespace {
 // - four lanes (AVX2): records past the caches (records_past_caches);
 // - eight lanes (AVX-512): past a third of the last-level cache on one thread, past the whole of
 //   it on two or more, where the cores' private caches hold more of the step.
-bool stream_pair_records(const State& s) {
+bool stream_pair_records(const PairStageView& s) {
   if (s.ctx.kernels->lanes != 8) return records_past_caches(s.pairs.out);
   const std::size_t bytes = s.pairs.out.size() * sizeof(double);
   const std::size_t cache = last_level_cache_bytes();
-  return thread_count(s) > 1 ? bytes > cache : bytes > cache / 3;
+  return s.threads > 1 ? bytes > cache : bytes > cache / 3;
 }
 
 // Whether some particle the pair list can reach has an angular velocity other than +0. Rotation
@@ -49,13 +48,13 @@ bool stream_pair_records(const State& s) {
 // soon where things do turn (the lattice). Where the pairs are few against the particles (a rigid
 // joint: ~160 pairs at the interface of two bodies of ~1400 particles), their two particles are
 // checked instead, which is the same question asked of fewer particles. Both scans run only
-// where the last step did not say (State::spin_known: the first step, and after the API changed
+// where the last step did not say (Caches::spin_known: the first step, and after the API changed
 // something); its answer covers every particle that is not inert, so it may say yes where a scan
 // of the pairs would say no, never the reverse.
-bool pairs_can_spin(const State& s) {
+bool pairs_can_spin(const PairStageView& s) {
   if (!s.any_rotating) return false;
-  // What the last step left (State::spin_known): the particles a pair can reach, or more.
-  if (s.cache.spin_known) return s.cache.spin_reachable != 0;
+  // What the last step left (Caches::spin_known): the particles a pair can reach, or more.
+  if (s.spin_known) return s.spin_reachable != 0;
   const ParticleStore& p = s.p;
   const PairStore& q = s.pairs;
   if (4 * q.n < p.n) {
@@ -78,7 +77,7 @@ bool pairs_can_spin(const State& s) {
 
 }  // namespace
 
-StageLoop pair_stage(State& s) {
+StageLoop pair_stage(const PairStageView& s) {
   auto args = pair_kernel_args(s);
   args.stream = stream_pair_records(s);
   const auto kernel = pairs_can_spin(s) ? s.ctx.kernels->pair : s.ctx.kernels->pair_norot;
@@ -92,9 +91,9 @@ StageLoop pair_stage(State& s) {
   if (q.live_current) {
     std::size_t live = 0;
     for (const std::uint8_t t : q.touched) live += t;
-    s.cache.pair_records_sparse = 2 * live < q.n;
+    s.records_sparse = 2 * live < q.n;
   }
-  q.live_written = s.cache.pair_records_sparse || s.step % 64 == 0;
+  q.live_written = s.records_sparse || s.step % 64 == 0;
   if (!q.live_written) args.live = nullptr;
   // A batch of pairs dead in the last step and in this one keeps its records instead of writing
   // the same zeros again: only where the flags are the last step's.
@@ -114,10 +113,10 @@ StageLoop pair_stage(State& s) {
     if (args.stream) _mm_sfence();  // the streamed records are visible to every thread after it
 #endif
   };
-  st.finish = [&s, slip, blocks = st.blocks] {
-    if (s.settings.track_energy)
-      for (std::size_t blk = 0; blk < blocks; ++blk) s.ledger.friction += slip[blk];
-  };
+  if (s.ledger)
+    st.finish = [ledger = s.ledger, slip, blocks = st.blocks] {
+      for (std::size_t blk = 0; blk < blocks; ++blk) ledger->friction += slip[blk];
+    };
   return st;
 }
 

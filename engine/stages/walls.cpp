@@ -10,7 +10,6 @@
 #include "bodies/mesh.hpp"
 #include "kernels/contact_law.hpp"
 #include "stages/walls.hpp"
-#include "state.hpp"
 
 namespace asperity::detail {
 
@@ -102,7 +101,7 @@ bool mesh_feature_contact_is_real(const Mesh& mesh, int t, int feature, const Ve
 // enough that they are not evicted again first; the distance is a trial's best, not derived.
 constexpr std::size_t kWallAhead = 32;
 
-StageLoop wall_stage(State& s) {
+StageLoop wall_stage(const WallStageView& s) {
   const std::size_t nw = s.walls.walls.size();
   WallContacts& wc = s.walls.contacts;
   wc.slip.resize(wc.n);  // an output only: a store read from a checkpoint has not sized it
@@ -163,8 +162,8 @@ StageLoop wall_stage(State& s) {
                               : kernels::scalar_kernels().plane_walls_norot;
   const std::size_t lanes = s.ctx.kernels->lanes;
   const bool any_prefetch = std::find(sums->prefetch.begin(), sums->prefetch.end(), 1) != sums->prefetch.end();
-  st.run = [&s, nw, sums, plane_args, plane_kernel, plane_tail, lanes, rot, any_prefetch](std::size_t blk) {
-    ParticleStore& p = s.p;
+  st.run = [s, nw, sums, plane_args, plane_kernel, plane_tail, lanes, rot, any_prefetch](std::size_t blk) {
+    const ParticleStore& p = s.p;
     WallContacts& wc = s.walls.contacts;
     const auto& walls = s.walls.walls;
     const double dt = s.dt;
@@ -281,14 +280,13 @@ StageLoop wall_stage(State& s) {
       work[blk] += dot(f, wall.velocity) * dt;  // model.md 8: boundary work of the wall
     }
   };
-  st.finish = [&s, nw, sums, blocks = st.blocks] {
-    auto& walls = s.walls.walls;
+  st.finish = [&walls = s.walls.walls, ledger = s.ledger, nw, sums, blocks = st.blocks] {
     for (auto& w : walls) w.force = {0, 0, 0};
     for (std::size_t blk = 0; blk < blocks; ++blk) {
       for (std::size_t w = 0; w < nw; ++w) walls[w].force += sums->force[blk * nw + w];
-      if (s.settings.track_energy) {
-        s.ledger.friction += sums->slip[blk];
-        s.ledger.boundary += sums->work[blk];
+      if (ledger) {
+        ledger->friction += sums->slip[blk];
+        ledger->boundary += sums->work[blk];
       }
     }
   };

@@ -1,9 +1,9 @@
 // Stage 4 of a step: ball-wall contact forces (stages/walls.cpp).
 #pragma once
-#include "state.hpp"
+#include "stages/views.hpp"
 
 namespace asperity::detail {
 
-StageLoop wall_stage(State& s);
+StageLoop wall_stage(const WallStageView& s);
 
 }  // namespace asperity::detail

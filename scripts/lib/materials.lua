@@ -45,7 +45,7 @@ M.rev = {
   bond_shear_ratio = 0.3,         -- kbs / kbn of the parallel bonds
   bond_radius_factor = 1,         -- lambda [3-26]
   -- A bonded particle does not rotate (1: the thesis's rule); with k > 1 a damaged one only while
-  -- it still holds k (model.md 2; stages/bonds.cpp).
+  -- it still holds k (model.md 2; neighbor/topology.cpp).
   rotation_lock_bonds = 1,
   -- The contact bond's strength factor c (model.md 5: Fcn = Fcs = c st A): "beam" breaks it with
   -- the parallel bond, "inf" never, a number > 0 at c st A.

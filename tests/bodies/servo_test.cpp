@@ -179,7 +179,7 @@ TEST(Servo, GainFollowsTheContactsOfEveryStep) {
   EXPECT_LT(worst, 1e-3) << "settled within 60 steps and held";
 }
 
-// The stiffness the servo's gain divides by (bodies/groups.cpp): per body, kn for each touching
+// The stiffness the servo's gain divides by (stages/groups.cpp): per body, kn for each touching
 // contact with another body, kn + beam_kn for each bond to another body, the wall's kn for each
 // wall contact. A 3 x 3 platen (servo) pressed 1 % onto a 3 x 3 layer held as a second body, which
 // rests on a third free layer; five of the nine pairs of each interface bonded, and a side wall

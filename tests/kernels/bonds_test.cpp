@@ -192,7 +192,7 @@ TEST(Bonds, CompressedBondFailsOnlyAtTenTimesTheStrength) {
 }
 
 // A broken bond's pair enters the contact list in the step that breaks it, without a neighbour
-// rebuild (a fracture run breaks bonds on most of its steps; stages/bonds.cpp, process_breaks),
+// rebuild (a fracture run breaks bonds on most of its steps; bond_list.cpp, process_breaks),
 // and the contact it leaves acts from the next step on with the contact law's force.
 TEST(Bonds, ABreakListsTheFreedPairWithoutARebuild) {
   BondMaterial bm;
@@ -531,7 +531,7 @@ TEST(Bonds, CriticalStepIncludesTheBondAndBondedRotationIsLocked) {
   EXPECT_THROW(w.set_angular_velocity(a, {1, 0, 0}), Error) << "locked while bonded";
 }
 
-// The rotation lock under damage (model.md 2, stages/bonds.cpp refresh_bond_topology): a particle
+// The rotation lock under damage (model.md 2, neighbor/topology.cpp refresh_bond_topology): a particle
 // none of whose bonds broke is locked however few it holds; a damaged one while it holds
 // rotation_lock_bonds. A star (centre with four bonds) and an arm (two bonds) lose bonds to
 // neighbours pulled away.
