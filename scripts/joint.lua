@@ -76,7 +76,7 @@ local P = params_lib.parse{
          .. "constant normal stiffness, sigma_0 + normal_stiffness x dilatancy"},
   {"normal_stiffness", 0, unit = "MPa/mm", min = 0, doc = "scaled to rock; of normal_control=stiffness (> 0 there, 0 otherwise)"},
   {"platen_damping", 0, below = 1, doc = "local damping of the dead-load platen (< 0: the world's)"},
-  {"servo_relaxation", 0.4, above = 0, max = 1, doc = "servo gain: fraction of the force error corrected per step"},
+  {"servo_relaxation", asperity.servo_defaults().relaxation, above = 0, max = 1, doc = "servo gain: fraction of the force error corrected per step"},
   {"servo_integral_steps", 2, min = 0, doc = "integral time of the servo, in time steps (0: proportional only)"},
   {"servo_max_velocity", 100, above = 0, doc = "the servo's speed limit, in shear velocities"},
   {"closure_velocity", 6e-5, unit = "m/s", above = 0, doc = "closure velocity [thesis 4.2.2]"},

@@ -232,6 +232,11 @@ int world_settings(lua_State* L) {
   });
 }
 
+int servo_defaults(lua_State* L) {
+  push_servo(L, Servo{});
+  return 1;
+}
+
 void open_world(lua_State* L) {
   std::vector<Function> methods;
   for (std::span<const Function> part : {world_particle_methods(), world_body_methods(), world_bond_methods(),
@@ -249,6 +254,9 @@ void open_world(lua_State* L) {
        world_settings_help()},
       {"load", load_world, "asperity.load(path [, {threads=, simd=}]) -> World",
        "A world from a checkpoint written by world:save(path)."},
+      {"servo_defaults", servo_defaults, "asperity.servo_defaults() -> {target_force=, relaxation=, ...}",
+       "The servo's fields at their defaults (the servo table of world:set_group_motion): scripts\n"
+       "take their defaults from here rather than writing them again."},
       {"bond_criterion", bond_criterion, "asperity.bond_criterion(sigma, tau, tensile_strength) -> f",
        "The elliptic strength criterion [3-46..3-49]: >= 1 means the bond fails."},
   };

@@ -31,6 +31,7 @@ void read_option(lua_State* L, Options& o, const Field& f, ContactMaterial& v);
 const char* dof_name(Dof d);  // "free", "fixed", "velocity", "servo"
 // The help lines of the servo's, the bond material's and a group motion's fields, from their tables.
 std::string servo_fields_help();
+void push_servo(lua_State* L, const Servo& s);  // its fields, from their table
 // A row (ContactInfo, BondInfo, BreakEvent) as a table, field by field from its table
 // (for_each_info, world.hpp): ids from 1, vectors as vec, modes and kinds by name.
 inline void push_info_value(lua_State* L, double v) { lua_pushnumber(L, v); }

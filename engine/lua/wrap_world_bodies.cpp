@@ -112,13 +112,6 @@ Servo servo_fields(lua_State* L, int index, const std::string& context, Servo s)
   return s;
 }
 
-void push_servo(lua_State* L, const Servo& s) {
-  lua_createtable(L, 0, 6);
-  for_each_field(s, [&](const Field& f, double v) {
-    lua_pushnumber(L, v);
-    lua_setfield(L, -2, f.name);
-  });
-}
 
 // A motion table (the fields of GroupMotion's table, world.hpp), read by the rules between its
 // fields: translation one mode for all axes or three; a velocity alone prescribes the
@@ -326,6 +319,14 @@ const char* add_group_help() {
 }
 
 }  // namespace
+
+void push_servo(lua_State* L, const Servo& s) {
+  lua_createtable(L, 0, 6);
+  for_each_field(s, [&](const Field& f, double v) {
+    lua_pushnumber(L, v);
+    lua_setfield(L, -2, f.name);
+  });
+}
 
 std::span<const Function> world_body_methods() {
   static const Function methods[] = {

@@ -136,7 +136,10 @@ struct Servo {
   double stiffness = 0;       // N/m; 0: constant normal load (CNL)
   double gain = 0;            // m/s per N; 0: automatic, relaxation / (K dt) with K the summed
                               // stiffness of the group's contacts this step (at least one kn)
-  double relaxation = 0.2;    // fraction of the force error corrected per step (automatic gain)
+  // Fraction of the force error corrected per step (automatic gain): the joint's closure and shear
+  // hold their target within 1 % at 0.4 (docs/model.md 7); at 1 a step would cancel the error
+  // that the contacts' own response also corrects, and the platen rings.
+  double relaxation = 0.4;
   double max_velocity = 1e-3; // m/s
   double integral_time = 0;   // s; > 0 adds integral action, v = G (e + (1/Ti) int e dt): a P servo
                               // lags by v/G whenever the specimen dilates at a steady rate

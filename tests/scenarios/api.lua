@@ -53,6 +53,10 @@ assert(w:group_motion(g2).damping < 0, "default: the world's local damping")
 w:set_group_motion(g2, {translation = {"velocity", "fixed", "servo"}, damping = 0,
                         servo = {target_force = 1e-6, integral_time = 0.01}})
 assert(w:group_motion(g2).damping == 0 and w:group_motion(g2).servo[3].integral_time == 0.01)
+-- The fields not given are the servo's defaults, which scripts read rather than write again.
+local servo_defaults = asperity.servo_defaults()
+assert(w:group_motion(g2).servo[3].relaxation == servo_defaults.relaxation and servo_defaults.relaxation > 0)
+assert(w:group_motion(g2).servo[3].max_velocity == servo_defaults.max_velocity and servo_defaults.target_force == 0)
 local ok, err = pcall(w.set_group_motion, w, g2, {servo = {integral_time = -1}})
 assert(not ok and tostring(err):find("integral_time"), tostring(err))
 ok, err = pcall(w.set_group_motion, w, g2, {damping = 1.5})
