@@ -145,8 +145,7 @@ void process_breaks(State& s) {
       // Breaking with the beam, the contact bond's lost energy is the beam event's too.
       const double contact_part = with_beam ? kernels::spring_energy(q, k, m) - spring_kept : 0.0;
       book(kernels::beam_energy(q, k, bm) + contact_part);
-      q.fbn[k] = q.fbsx[k] = q.fbsy[k] = q.fbsz[k] = 0;
-      q.mbn[k] = q.mbsx[k] = q.mbsy[k] = q.mbsz[k] = 0;
+      kernels::unload_beam(q, k);
     }
     if (contact_goes && !with_beam) {
       const double rb = q.beam_radius[k], A = kernels::kPi * rb * rb;
@@ -242,8 +241,8 @@ std::size_t install_bonds(State& s, const BondMaterial& material, double toleran
     fresh.overlap[k] = p.radius[a] + p.radius[b] - d;
     fresh.rest[k] = stress_free ? fresh.overlap[k] : 0.0;
     fresh.fn[k] = s.settings.contact.kn * (fresh.overlap[k] - fresh.rest[k]);
-    fresh.fbn[k] = fresh.fbsx[k] = fresh.fbsy[k] = fresh.fbsz[k] = 0;
-    fresh.mbn[k] = fresh.mbsx[k] = fresh.mbsy[k] = fresh.mbsz[k] = fresh.broken[k] = 0;
+    kernels::unload_beam(fresh, k);
+    fresh.broken[k] = 0;
     fresh.holds[k] = kBothHold;
   }
   s.bonds = merge_bonds(s.bonds, fresh);

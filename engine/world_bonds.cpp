@@ -93,8 +93,7 @@ std::vector<BondInfo> World::bonds() const {
     b.beam_radius = q.beam_radius[k];
     b.normal_force = q.fn[k] + q.fbn[k];
     b.shear_force = {q.fsx[k] + q.fbsx[k], q.fsy[k] + q.fbsy[k], q.fsz[k] + q.fbsz[k]};
-    b.twisting_moment = q.mbn[k];
-    b.bending_moment = {q.mbsx[k], q.mbsy[k], q.mbsz[k]};
+    kernels::beam_moments(q, k, b.twisting_moment, b.bending_moment);
     kernels::beam_stresses(q, k, b.sigma, b.tau);
     b.beam = q.holds[k] != detail::kContactBondHolds;
     b.contact_bond = q.holds[k] != detail::kBeamHolds;

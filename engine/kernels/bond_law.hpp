@@ -16,6 +16,7 @@
 #include <cstddef>
 
 #include "asperity/materials.hpp"
+#include "asperity/vec3.hpp"
 #include "kernels/contact_law.hpp"
 
 namespace asperity::kernels {
@@ -143,6 +144,26 @@ inline double beam_energy(const Store& q, std::size_t k, const BondMaterial& bm)
          (q.fbsx[k] * q.fbsx[k] + q.fbsy[k] * q.fbsy[k] + q.fbsz[k] * q.fbsz[k]) / (2 * bm.beam_ks) +
          q.mbn[k] * q.mbn[k] / (2 * bm.beam_ks * 0.5 * r2) +
          (q.mbsx[k] * q.mbsx[k] + q.mbsy[k] * q.mbsy[k] + q.mbsz[k] * q.mbsz[k]) / (2 * bm.beam_kn * 0.25 * r2);
+}
+
+// The beam's twisting moment (along n) and bending moment, on b (on a: their negatives).
+template <class Store>
+inline void beam_moments(const Store& q, std::size_t k, double& twisting, Vec3& bending) {
+  twisting = q.mbn[k];
+  bending = {q.mbsx[k], q.mbsy[k], q.mbsz[k]};
+}
+
+// Whether the beam carries no moment (+-0): only spin makes one grow (BondStore's layouts).
+template <class Store>
+inline bool beam_moments_zero(const Store& q, std::size_t k) {
+  return q.mbn[k] == 0 && q.mbsx[k] == 0 && q.mbsy[k] == 0 && q.mbsz[k] == 0;
+}
+
+// The beam unloaded: forces and moments zero (a new beam, or one that broke).
+template <class Store>
+inline void unload_beam(Store& q, std::size_t k) {
+  q.fbn[k] = q.fbsx[k] = q.fbsy[k] = q.fbsz[k] = 0;
+  q.mbn[k] = q.mbsx[k] = q.mbsy[k] = q.mbsz[k] = 0;
 }
 
 // Strain energy of the contact springs (model.md 8): Fn^2/(2 kn) + |Fs|^2/(2 ks).

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "kernels/bond_law.hpp"
 #include "neighbor/build.hpp"
 
 namespace asperity::detail {
@@ -41,7 +42,7 @@ void refresh_bond_topology(State& s) {
   // Beam moments: new bonds start without one, and a checkpoint or a break may bring back some.
   s.cache.bond_moments_zero = true;
   for (std::size_t k = 0; k < q.n && s.cache.bond_moments_zero; ++k)
-    s.cache.bond_moments_zero = q.mbn[k] == 0 && q.mbsx[k] == 0 && q.mbsy[k] == 0 && q.mbsz[k] == 0;
+    s.cache.bond_moments_zero = kernels::beam_moments_zero(q, k);
   // Rotation locks [thesis 3.3]: "restricting the particle rotation when they are bonded together";
   // how far the restriction goes is the calibration's choice (model.md 2). A particle none of whose
   // bonds has broken does not rotate; a damaged one stays locked while it holds rotation_lock_bonds
