@@ -72,10 +72,10 @@ std::int64_t World::add_particles(std::span<const double> xyz, std::span<const d
   const double rho = density <= 0 ? s.settings.density : density;
   check_setting("add_particle", "density", rho);
   for (std::size_t k = 0; k < radii.size(); ++k) {
-    const std::string which = radii.size() > 1 ? " of particle " + std::to_string(k + 1) : "";
-    require_radius(radii[k], "add_particle: radius" + which);
-    require_position({xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]},
-                     ("add_particle: position" + which).c_str());
+    auto which = [&] { return radii.size() > 1 ? " of particle " + std::to_string(k + 1) : std::string(); };
+    require_radius(radii[k], [&] { return "add_particle: radius" + which(); });
+    require_position(Vec3{xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]},
+                     [&] { return "add_particle: position" + which(); });
   }
   auto& p = s.p;
   const std::size_t first = p.n;
@@ -174,7 +174,7 @@ void World::set_angular_velocity(std::int64_t id, Vec3 w) {
   changed(*state_, Change::spins);
 }
 void World::set_radius(std::int64_t id, double r) {
-  require_radius(r, "set_radius: radius");
+  require_radius(r, [] { return "set_radius: radius"; });
   auto& p = state_->p;
   const auto i = index_of(*state_, id);
   p.radius[i] = r;
@@ -187,8 +187,9 @@ void World::scale_radii(double factor) {
   auto& p = state_->p;
   // Every new radius within bounds before any changes (a failed call leaves the world as it was).
   for (std::size_t i = 0; i < p.n; ++i)
-    require_radius(p.radius[i] * factor, "scale_radii: factor " + num(factor) + " makes the radius of particle " +
-                                             std::to_string(p.id[i] + 1));
+    require_radius(p.radius[i] * factor, [&] {
+      return "scale_radii: factor " + num(factor) + " makes the radius of particle " + std::to_string(p.id[i] + 1);
+    });
   for (std::size_t i = 0; i < p.n; ++i) {
     p.radius[i] *= factor;
     set_mass(p, i);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <concepts>
 #include <numbers>
 #include <string>
 #include <string_view>
@@ -31,24 +32,39 @@ inline std::string vec_text(const Vec3& v) {
 template <class T>
 inline void check_value(const std::string& where, const Field& f, const T& v) {
   const std::string problem = detail::field_problem(f, v);
-  require(problem.empty(), where + problem);
+  if (!problem.empty()) throw Error(where + problem);
 }
 
 inline void require_finite(const Vec3& v, const char* what) { check_value("", Field{what}, v); }
 
 // Positions (particles, plane points, mesh vertices) within kMaxCoordinate of the origin: the
 // cell grids take differences of coordinates, which must not overflow.
+// The messages of these are built only when the check fails: a genesis calls them for every
+// particle at every one of its hundreds of radius updates.
 inline void require_position(const Vec3& v, const char* what) {
   require_finite(v, what);
-  require(std::fabs(v.x) <= kMaxCoordinate && std::fabs(v.y) <= kMaxCoordinate &&
-              std::fabs(v.z) <= kMaxCoordinate,
-          std::string(what) + " " + vec_text(v) + " outside [-" + num(kMaxCoordinate) + ", " +
-              num(kMaxCoordinate) + "] m on some axis");
+  if (!(std::fabs(v.x) <= kMaxCoordinate && std::fabs(v.y) <= kMaxCoordinate &&
+        std::fabs(v.z) <= kMaxCoordinate))
+    throw Error(std::string(what) + " " + vec_text(v) + " outside [-" + num(kMaxCoordinate) + ", " +
+                num(kMaxCoordinate) + "] m on some axis");
 }
 
-inline void require_radius(double r, const std::string& what) {
-  require(r >= kMinRadius && r <= kMaxRadius,
-          what + " " + num(r) + " outside [" + num(kMinRadius) + ", " + num(kMaxRadius) + "] m");
+// what(): which position, e.g. "add_particle: position of particle 3".
+template <class What>
+  requires std::invocable<What>
+inline void require_position(const Vec3& v, What&& what) {
+  const bool ok = std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) &&
+                  std::fabs(v.x) <= kMaxCoordinate && std::fabs(v.y) <= kMaxCoordinate &&
+                  std::fabs(v.z) <= kMaxCoordinate;
+  if (!ok) require_position(v, std::string(what()).c_str());  // throws, saying what is wrong
+}
+
+// what(): which radius, e.g. "set_radius: radius".
+template <class What>
+inline void require_radius(double r, What&& what) {
+  if (!(r >= kMinRadius && r <= kMaxRadius))
+    throw Error(std::string(what()) + " " + num(r) + " outside [" + num(kMinRadius) + ", " +
+                num(kMaxRadius) + "] m");
 }
 
 inline void check_material(const ContactMaterial& m, const std::string& where) {

@@ -2,8 +2,8 @@
 # The joint end to end, as a user runs it: the genesis, then the rigid, elastic and fracture
 # shears of one surface at one size, one after the other on the same cores, each a plain
 # `asperity run scripts/joint.lua` command. Prints the wall time of each phase (genesis, closure
-# and set-up, shear) and the cost per particle-step of each shear, and appends one row per model
-# to perf/results/<cpu-model>-joint.csv.
+# and set-up, shear), the cost per particle-step of each shear and the run's peak memory, and
+# appends one row per model to perf/results/<cpu-model>-joint.csv.
 #
 #   perf/joint_end_to_end.sh                                  # 2 cm S1, 14 MPa, 2 threads
 #   SIZE=0.1 perf/joint_end_to_end.sh                         # the thesis's 10 cm
@@ -31,7 +31,7 @@ commit=$(git describe --always --dirty 2>/dev/null || echo unknown)
 source perf/results_file.sh
 cpu=$(cpu_model)
 csv=$(results_file . -joint)
-[ -f "$csv" ] || echo "date,cpu_model,commit,size_m,surface,stress_mpa,model,threads,speedup,particles,genesis_s,setup_s,shear_s,shear_steps,ns_per_particle_step,wall_s,load_avg" > "$csv"
+[ -f "$csv" ] || echo "date,cpu_model,commit,size_m,surface,stress_mpa,model,threads,speedup,particles,genesis_s,setup_s,shear_s,shear_steps,ns_per_particle_step,wall_s,load_avg,peak_memory_mb" > "$csv"
 
 start=$(date +%s)
 for model in $MODELS; do
@@ -54,11 +54,14 @@ setup = wall - shear - genesis
 n, steps = s["n_particles"], s["shear_steps"]
 ns = 1e9 * shear / max(1, n * steps)
 load = os.getloadavg()[0]
+memory = s.get("peak_memory_bytes", 0) / 2**20  # of the whole run (the genesis too, where it packed)
 print(f"   genesis {genesis:8.0f} s   closure + set-up {setup:7.0f} s   shear {shear:7.0f} s "
-      f"({steps} steps, {ns:.1f} ns per particle-step, {n} particles)   total {wall:7.0f} s")
+      f"({steps} steps, {ns:.1f} ns per particle-step, {n} particles)   total {wall:7.0f} s   "
+      f"peak memory {memory:.0f} MB")
 with open(csv, "a") as f:
     f.write(f'{time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())},"{cpu}",{commit},{size},{surface},{stress},'
-            f'{model},{threads},{speed},{n},{genesis:.1f},{setup:.1f},{shear:.1f},{steps},{ns:.2f},{wall:.1f},{load:.2f}\n')
+            f'{model},{threads},{speed},{n},{genesis:.1f},{setup:.1f},{shear:.1f},{steps},{ns:.2f},{wall:.1f},{load:.2f},'
+            f'{memory:.0f}\n')
 EOF
 done
 echo "== end to end: $(( $(date +%s) - start )) s (rows in $csv)"

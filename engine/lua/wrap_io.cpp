@@ -1,9 +1,13 @@
 // Module-level functions of `asperity`: JSON, HDF5 read-back, directories, plots of arrays,
 // clocks, version information.
-#include <filesystem>
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 #include "asperity/io.hpp"
 #include "asperity/world.hpp"
@@ -243,6 +247,23 @@ int l_wall_time(lua_State* L) {
   return 1;
 }
 
+// The process's resident memory now (/proc/self/statm, resident pages) and its peak
+// (getrusage: ru_maxrss, in KiB on Linux), in bytes; 0 where the system does not say.
+int l_memory(lua_State* L) {
+  double resident = 0, peak = 0;
+  std::ifstream statm("/proc/self/statm");
+  double total_pages = 0, resident_pages = 0;
+  if (statm >> total_pages >> resident_pages) resident = resident_pages * double(sysconf(_SC_PAGESIZE));
+  rusage ru{};
+  if (getrusage(RUSAGE_SELF, &ru) == 0) peak = 1024.0 * double(ru.ru_maxrss);
+  lua_createtable(L, 0, 2);
+  lua_pushnumber(L, resident);
+  lua_setfield(L, -2, "resident");
+  lua_pushnumber(L, std::max(peak, resident));
+  lua_setfield(L, -2, "peak");
+  return 1;
+}
+
 int l_simd_architectures(lua_State* L) {
   return guarded(L, [&] {
     std::vector<std::string> names = available_simd_architectures();
@@ -276,6 +297,9 @@ void open_io(lua_State* L) {
        "  [, logy=] [, points=]} -> file",
        "A PNG drawn by gnuplot from Arrays or tables. Labels as \"name [unit]\"."},
       {"wall_time", l_wall_time, "asperity.wall_time() -> s", "A monotonic clock, for timing."},
+      {"memory", l_memory, "asperity.memory() -> {resident=, peak=}",
+       "This process's resident memory now and at its peak, in bytes (0 where the system does not\n"
+       "say): what a run needs, e.g. to plan a larger one."},
       {"simd_architectures", l_simd_architectures, "asperity.simd_architectures() -> {names}",
        "What this CPU supports, best first."},
   };

@@ -393,49 +393,56 @@ void build_wall_contacts(State& s) {
   const std::size_t n = p.n;
   auto& walls = s.walls.walls;
   struct Candidate {
-    std::int32_t wall, facet;
+    std::int32_t particle, wall, facet;
     double distance;  // centre to the triangle (mesh); 0 for a plane
   };
-  std::vector<std::vector<Candidate>> cand(n);  // per particle
+  // Per chunk of kChunk particles, in particle order (the unit the threads share out): a few
+  // hundred lists where one per particle would be a hundred thousand small ones, allocated again
+  // at every build, whose growing sizes fragment the heap (a genesis rebuilds hundreds of times
+  // while its radii grow, and its resident memory grew with them).
+  constexpr std::size_t kChunk = 256;
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<std::vector<Candidate>> cand(chunks);
   for (Wall& wall : walls)
     wall.candidates_within_half_skin =
         wall.kind == Wall::Kind::mesh && !wall.removed && wall.velocity == Vec3{0, 0, 0};
 #pragma omp parallel num_threads(thread_count(s))
   {
     std::vector<std::int32_t> tris;
-#pragma omp for schedule(dynamic, 256)
-    for (std::size_t i = 0; i < n; ++i) {
-      if (p.inert[i]) continue;
-      const Vec3 c{p.x[i], p.y[i], p.z[i]};
-      const double reach = p.radius[i] + s.skin;
-      // A free particle's triangles of a still mesh within R + skin/2 (Wall::candidates_within_
-      // half_skin): one farther away stays farther than R while the particle and the wall close at
-      // most skin/2 (the rebuild rule), so the wall stage would skip it at every step until the
-      // next build (stages/walls.cpp, the same rounding margin). Dropping it changes no bit.
-      const double near_reach = (p.radius[i] + 0.5 * s.skin) * (1 + 1e-9);
-      for (std::size_t w = 0; w < walls.size(); ++w) {
-        const Wall& wall = walls[w];
-        if (wall.removed) continue;
-        if (wall.kind == Wall::Kind::plane) {
-          const double d = dot(c - (wall.point + wall.displacement), wall.normal);
-          if (d < reach) cand[i].push_back({std::int32_t(w), 0, 0.0});
-        } else {
-          const Mesh& mesh = s.walls.meshes[wall.mesh];
-          const Vec3 q = c - wall.displacement;
-          const double r = wall.candidates_within_half_skin && p.group[i] < 0 ? near_reach : reach;
-          query_mesh(mesh, q, r, tris);
-          for (std::int32_t t : tris) {
-            const auto& tri = mesh.triangles[t];
-            int feature;
-            const Vec3 cp = closest_point_on_triangle(q, mesh.vertices[tri[0]],
-                                                      mesh.vertices[tri[1]],
-                                                      mesh.vertices[tri[2]], feature);
-            const Vec3 d = q - cp;
-            if (dot(d, d) < r * r) cand[i].push_back({std::int32_t(w), t, norm(d)});
+#pragma omp for schedule(dynamic, 1)
+    for (std::size_t chunk = 0; chunk < chunks; ++chunk)
+      for (std::size_t i = chunk * kChunk; i < std::min(n, (chunk + 1) * kChunk); ++i) {
+        if (p.inert[i]) continue;
+        const Vec3 c{p.x[i], p.y[i], p.z[i]};
+        const double reach = p.radius[i] + s.skin;
+        // A free particle's triangles of a still mesh within R + skin/2 (Wall::candidates_within_
+        // half_skin): one farther away stays farther than R while the particle and the wall close
+        // at most skin/2 (the rebuild rule), so the wall stage would skip it at every step until
+        // the next build (stages/walls.cpp, the same rounding margin). Dropping it changes no bit.
+        const double near_reach = (p.radius[i] + 0.5 * s.skin) * (1 + 1e-9);
+        for (std::size_t w = 0; w < walls.size(); ++w) {
+          const Wall& wall = walls[w];
+          if (wall.removed) continue;
+          if (wall.kind == Wall::Kind::plane) {
+            const double d = dot(c - (wall.point + wall.displacement), wall.normal);
+            if (d < reach) cand[chunk].push_back({std::int32_t(i), std::int32_t(w), 0, 0.0});
+          } else {
+            const Mesh& mesh = s.walls.meshes[wall.mesh];
+            const Vec3 q = c - wall.displacement;
+            const double r = wall.candidates_within_half_skin && p.group[i] < 0 ? near_reach : reach;
+            query_mesh(mesh, q, r, tris);
+            for (std::int32_t t : tris) {
+              const auto& tri = mesh.triangles[t];
+              int feature;
+              const Vec3 cp = closest_point_on_triangle(q, mesh.vertices[tri[0]],
+                                                        mesh.vertices[tri[1]],
+                                                        mesh.vertices[tri[2]], feature);
+              const Vec3 d = q - cp;
+              if (dot(d, d) < r * r) cand[chunk].push_back({std::int32_t(i), std::int32_t(w), t, norm(d)});
+            }
           }
         }
       }
-    }
   }
   WallContacts fresh;
   std::size_t total = 0;
@@ -443,16 +450,16 @@ void build_wall_contacts(State& s) {
   fresh.resize(total);
   fresh.start.assign(n + 1, 0);
   std::size_t k = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    for (const Candidate& c : cand[i]) {
-      fresh.particle[k] = std::int32_t(i);
+  for (const auto& list : cand)
+    for (const Candidate& c : list) {
+      fresh.particle[k] = c.particle;
       fresh.wall[k] = c.wall;
       fresh.facet[k] = c.facet;
       fresh.distance[k] = c.distance;
+      ++fresh.start[std::size_t(c.particle) + 1];
       ++k;
     }
-    fresh.start[i + 1] = std::int32_t(k);
-  }
+  for (std::size_t i = 0; i < n; ++i) fresh.start[i + 1] += fresh.start[i];
   // Carry history, both lists sorted by (particle, wall, facet).
   const WallContacts& old = s.walls.contacts;
   std::size_t o = 0;

@@ -147,3 +147,14 @@ assert(not ok and err:find("no particle 99 (valid: 1..5)", 1, true), err)
 ok, err = pcall(function() return w:run{steps = 10, every = 5, callback = function() error("inner") end} end)
 assert(not ok and err:find("api.lua:%d+: inner"), err)
 print("PASS")
+
+-- The process's memory: resident now and its peak, in bytes; 64 MB held raise both by about that.
+do
+  local before = asperity.memory()
+  assert(before.resident > 0 and before.peak >= before.resident, "memory: resident and peak")
+  local held = string.rep("x", 64 * 2^20)
+  local now = asperity.memory()
+  assert(now.resident >= before.resident + 60 * 2^20 and now.peak >= now.resident,
+         ("memory: %d -> %d bytes resident with 64 MB held"):format(before.resident, now.resident))
+  assert(#held == 64 * 2^20)
+end

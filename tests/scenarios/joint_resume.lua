@@ -138,7 +138,8 @@ end
 -- The summary: every result equal; what depends on the attempts (wall times, rebuilds after a
 -- load, the cadence of saves, the resumes) and the output folder aside.
 local ASIDE = {wall_seconds = true, shear_seconds = true, shear_microseconds_per_step = true, specimen_seconds = true,
-               specimen_packed = true, shear_rebuilds = true, resumes = true, checkpoint_every = true, out = true}
+               specimen_packed = true, shear_rebuilds = true, resumes = true, checkpoint_every = true, out = true,
+               peak_memory_bytes = true, memory_bytes_per_particle = true}
 local function compare(a, b, path)
   if type(a) ~= "table" or type(b) ~= "table" then
     assert(a == b or (a ~= a and b ~= b), ("summary %s: %s resumed, %s unbroken"):format(path, tostring(b), tostring(a)))

@@ -182,6 +182,7 @@ function M.write(run)
   local function share(v) return input ~= 0 and v / input or 0/0 end
   local broken_depths, broken_fraction = broken_by_depth(run)
   local plane_lower, cls = run.plane_lower, run.cls
+  local memory = asperity.memory()
   local summary = {
     parameters = P,
     surface = {nx = s.nx, ny = s.ny, spacing = s.h, side_x = s.Lx, side_y = s.Ly},
@@ -247,6 +248,9 @@ function M.write(run)
     shear_microseconds_per_step = 1e6 * run.shear_seconds / math.max(run.shear_steps, 1),  -- cost of one step
     dt = world:dt(),
     wall_seconds = asperity.wall_time() - run.t_start,   -- of every attempt, when resumed
+    -- The process's peak resident memory (of this attempt, when resumed), whole and per particle.
+    peak_memory_bytes = memory.peak,
+    memory_bytes_per_particle = memory.peak / math.max(1, #run.lower + #run.upper),
     resumes = run.resumes or 0,              -- times the run was resumed from its saved state
     specimen_cache = run.cache_file,
     specimen_packed = run.specimen_packed,   -- packed by this run (its wall time includes the genesis)
@@ -260,6 +264,8 @@ function M.write(run)
                     peak = peak, at = at, residual = residual})
   plot_maps(run)
 
+  run:log("peak memory %.0f MB (%.0f bytes per particle)", summary.peak_memory_bytes / 2^20,
+          summary.memory_bytes_per_particle)
   print(("%s %s %g MPa -%s: %d particles, peak %.2f MPa at %.2f mm, residual %.2f MPa, " ..
          "max dilatancy %.3f mm, %d broken bonds, %.0f s"):format(P.surface, P.model, P.stress,
     P.direction, summary.n_particles, peak, u[at], residual, max_dil, world:break_count(),
