@@ -24,7 +24,7 @@ double kept_as_contact(const BondStore& q, std::size_t k, const ContactMaterial&
   const double fs2 = q.fsx[k] * q.fsx[k] + q.fsy[k] * q.fsy[k] + q.fsz[k] * q.fsz[k];
   const double limit = m.friction * fn, fs = std::sqrt(fs2);
   fs_scale = fs > limit ? limit / fs : 1.0;
-  return fn * fn / (2 * m.kn) + fs2 * fs_scale * fs_scale / (2 * m.ks);
+  return kernels::contact_spring_energy(fn, fs2 * fs_scale * fs_scale, m.kn, m.ks);
 }
 }  // namespace
 

@@ -310,15 +310,15 @@ Energies compute_energies(const State& s) {
   const PairStore& q = s.pairs;
   for (std::size_t k = 0; k < q.n; ++k) {
     if (!(q.overlap_at(k) > 0)) continue;
-    e.strain += q.normal_force(k) * q.normal_force(k) / (2 * m.kn) +
-                (q.fsx[k] * q.fsx[k] + q.fsy[k] * q.fsy[k] + q.fsz[k] * q.fsz[k]) / (2 * m.ks);
+    e.strain += kernels::contact_spring_energy(
+        q.normal_force(k), q.fsx[k] * q.fsx[k] + q.fsy[k] * q.fsy[k] + q.fsz[k] * q.fsz[k], m.kn, m.ks);
   }
   const WallContacts& wc = s.walls.contacts;
   for (std::size_t k = 0; k < wc.n; ++k) {
     if (!(wc.overlap[k] > 0)) continue;
     const ContactMaterial& wm = s.walls.walls[wc.wall[k]].material;
-    e.strain += wc.fn[k] * wc.fn[k] / (2 * wm.kn) +
-                (wc.fsx[k] * wc.fsx[k] + wc.fsy[k] * wc.fsy[k] + wc.fsz[k] * wc.fsz[k]) / (2 * wm.ks);
+    e.strain += kernels::contact_spring_energy(
+        wc.fn[k], wc.fsx[k] * wc.fsx[k] + wc.fsy[k] * wc.fsy[k] + wc.fsz[k] * wc.fsz[k], wm.kn, wm.ks);
   }
   const BondMaterial& bm = s.bonds.material;
   for_each_bond(s, [&](const BondStore& bq, std::size_t k) {  // a frozen bond keeps its energy

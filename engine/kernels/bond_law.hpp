@@ -169,7 +169,7 @@ inline void unload_beam(Store& q, std::size_t k) {
 // Strain energy of the contact springs (model.md 8): Fn^2/(2 kn) + |Fs|^2/(2 ks).
 template <class Store>
 inline double spring_energy(const Store& q, std::size_t k, const ContactMaterial& m) {
-  return q.fn[k] * q.fn[k] / (2 * m.kn) + (q.fsx[k] * q.fsx[k] + q.fsy[k] * q.fsy[k] + q.fsz[k] * q.fsz[k]) / (2 * m.ks);
+  return contact_spring_energy(q.fn[k], q.fsx[k] * q.fsx[k] + q.fsy[k] * q.fsy[k] + q.fsz[k] * q.fsz[k], m.kn, m.ks);
 }
 
 }  // namespace asperity::kernels

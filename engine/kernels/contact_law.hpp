@@ -170,4 +170,11 @@ inline void ball_ball_geometry(const T& xa, const T& ya, const T& za, const T& x
   lb = rb - 0.5 * U;
 }
 
+// Strain energy of a contact's springs (model.md 8): Fn^2/(2 kn) + |Fs|^2/(2 ks), with fs2 = |Fs|^2.
+// The one formula for touching pairs and wall contacts (step.cpp) and for a bond's contact springs
+// (bond_law.hpp, bond_list.cpp).
+inline double contact_spring_energy(double fn, double fs2, double kn, double ks) {
+  return fn * fn / (2 * kn) + fs2 / (2 * ks);
+}
+
 }  // namespace asperity::kernels
