@@ -36,6 +36,7 @@ local P = params_lib.parse{
   {"contact_bond_friction", mat.rev.contact_bond_friction, min = 0, doc = "passed to rev.lua"},
   {"grow_floaters", mat.genesis.grow_floaters, doc = "passed to rev.lua"},
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "passed to rev.lua"},
+  {"genesis_shrink_gain", 1, above = 0, max = 1, doc = "passed to rev.lua"},
   {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "passed to rev.lua"},
   {"out", "out/calibration", nonempty = true, doc = "output folder (one folder per trial and seed)"},
   {"cache", "", doc = "packings cached here (\"\": out/cache)"},
@@ -66,7 +67,7 @@ local function rev(st, tests, seed, name)
             contact_strength = P.contact_strength, contact_shear_strength = P.contact_shear_strength,
             contact_bond_friction = P.contact_bond_friction,
             grow_floaters = P.grow_floaters,
-            genesis_stress = P.genesis_stress, porosity = P.porosity,
+            genesis_stress = P.genesis_stress, genesis_shrink_gain = P.genesis_shrink_gain, porosity = P.porosity,
             out = ("%s/%s_seed%d"):format(out, name, seed)}
   return dofile(rev_script)
 end
