@@ -73,9 +73,10 @@ int main(int argc, char** argv) {
 #if defined(__GLIBC__)
   // Blocks of 128 kB and more are mapped on their own, and the threshold stays there. glibc starts
   // at 128 kB but raises it to the size of each mapped block freed (up to 32 MB), after which the
-  // index arrays a neighbour build allocates and frees come from the heap, whose holes they leave
-  // (each build a little larger, as a genesis grows its radii) are not reused: a 2 cm genesis
-  // then held 142 MB at its peak instead of 66 (of which 30 is the program and Lua).
+  // arrays of 128-256 kB that each neighbour build allocates anew come from the heap (the engine
+  // maps its own from 256 kB, core/aligned.hpp), and the holes they leave, each build a little
+  // larger as a genesis grows its radii, are not reused: a 2 cm genesis then held 142 MB at its
+  // peak instead of 62 (of which 20 is the program and Lua).
   mallopt(M_MMAP_THRESHOLD, 128 << 10);
 #endif
   std::string command = argv[1];
