@@ -38,13 +38,17 @@ inline void check_value(const std::string& where, const Field& f, const T& v) {
 inline void require_finite(const Vec3& v, const char* what) { check_value("", Field{what}, v); }
 
 // Positions (particles, plane points, mesh vertices) within kMaxCoordinate of the origin: the
-// cell grids take differences of coordinates, which must not overflow.
+// cell grids take differences of coordinates, which must not overflow (NaN fails too).
+inline bool position_within_bounds(const Vec3& v) {
+  return std::fabs(v.x) <= kMaxCoordinate && std::fabs(v.y) <= kMaxCoordinate &&
+         std::fabs(v.z) <= kMaxCoordinate;
+}
+
 // The messages of these are built only when the check fails: a genesis calls them for every
 // particle at every one of its hundreds of radius updates.
 inline void require_position(const Vec3& v, const char* what) {
   require_finite(v, what);
-  if (!(std::fabs(v.x) <= kMaxCoordinate && std::fabs(v.y) <= kMaxCoordinate &&
-        std::fabs(v.z) <= kMaxCoordinate))
+  if (!position_within_bounds(v))
     throw Error(std::string(what) + " " + vec_text(v) + " outside [-" + num(kMaxCoordinate) + ", " +
                 num(kMaxCoordinate) + "] m on some axis");
 }
@@ -53,10 +57,7 @@ inline void require_position(const Vec3& v, const char* what) {
 template <class What>
   requires std::invocable<What>
 inline void require_position(const Vec3& v, What&& what) {
-  const bool ok = std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) &&
-                  std::fabs(v.x) <= kMaxCoordinate && std::fabs(v.y) <= kMaxCoordinate &&
-                  std::fabs(v.z) <= kMaxCoordinate;
-  if (!ok) require_position(v, std::string(what()).c_str());  // throws, saying what is wrong
+  if (!position_within_bounds(v)) require_position(v, std::string(what()).c_str());  // throws, naming it
 }
 
 // what(): which radius, e.g. "set_radius: radius".
