@@ -138,6 +138,7 @@ Vec3 World::torque(std::int64_t id) const {
 #undef ASPERITY_VEC
 double World::radius(std::int64_t id) const { return state_->p.radius[index_of(*state_, id)]; }
 double World::mass(std::int64_t id) const { return state_->p.mass[index_of(*state_, id)]; }
+double World::density(std::int64_t id) const { return state_->p.density[index_of(*state_, id)]; }
 int World::group_of(std::int64_t id) const { return state_->p.group[index_of(*state_, id)]; }
 
 void World::set_position(std::int64_t id, Vec3 x) {
@@ -180,6 +181,15 @@ void World::set_radius(std::int64_t id, double r) {
   p.radius[i] = r;
   set_mass(p, i);
   for (auto& g : state_->groups) recompute_group(*state_, g);
+  changed(*state_, Change::particles);
+}
+void World::set_density(std::int64_t id, double rho) {
+  check_setting("set_density", "density", rho);
+  auto& p = state_->p;
+  const auto i = index_of(*state_, id);
+  p.density[i] = rho;
+  set_mass(p, i);
+  if (p.group[i] >= 0) recompute_group(*state_, state_->groups[p.group[i]]);
   changed(*state_, Change::particles);
 }
 void World::scale_radii(double factor) {

@@ -94,6 +94,7 @@ local P = params_lib.parse{
   {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "thesis definition [3-35]: the particle count of the genesis"},
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "isotropic stress installed before bonding (scenarios.md 1; model units)"},
   {"genesis_shrink_gain", 1, above = 0, max = 1, doc = "the stress servo's gain when it shrinks the radii, relative to when it grows them (< 1: fewer steps, a slightly different packing)"},
+  {"genesis_mass_floor", 0, min = 0, max = 2, doc = "while packing, particles smaller than this x mean radius weigh as one of it (a larger time step; 0: true masses)"},
   {"bond_gap", 0, unit = "m", min = 0, doc = "largest gap bonded (0: the engine's default, 1e-3 x mean radius)"},
   {"tensile_strength", mat.rev.bond_tensile_strength, unit = "Pa", above = 0,
    doc = "fracture model: bond strength st (model units; the REV's calibrated one by default)"},
@@ -112,6 +113,9 @@ local P = params_lib.parse{
   {"dt_safety", 0, min = 0, max = 2,
    doc = "time step / critical estimate for closure and shear (0: 1.0 elastic and fracture, 0.8 rigid; above 1 only to study instability)"},
   {"skin", 0, unit = "m", min = 0, doc = "Verlet skin (0: 0.1 mean radius, the rigid model 0.4)"},
+  {"mass_floor", 0, min = 0, max = 2,
+   doc = "elastic and fracture: particles smaller than this x mean radius weigh as one of it in the closure and shear "
+      .. "(the lightest set the critical time step; 0: true masses)"},
   {"snapshots", "0,1,2.5,5", list = "number", unit = "mm", min = 0,
    doc = "shear displacements of the particle snapshots, within 0 .. shear (\"\": none; by default those "
          .. "within a shorter shear and its end)"},

@@ -110,6 +110,15 @@ int world_set_radius(lua_State* L) {
   });
 }
 
+int world_set_density(lua_State* L) {
+  return guarded(L, [&] {
+    World& w = world_arg(L);
+    std::int64_t id = particle_arg(L, 2, w);
+    w.set_density(id, check_number(L, 3));
+    return 0;
+  });
+}
+
 int world_set_rotation_locked(lua_State* L) {
   return guarded(L, [&] {
     World& w = world_arg(L);
@@ -248,6 +257,7 @@ std::span<const Function> world_particle_methods() {
       {"torque", get_particle_vec<&World::torque>, "world:torque(id) -> vec", "Torque of the last step (N m)."},
       {"radius", get_particle_number<&World::radius>, "world:radius(id) -> r", "Radius (m)."},
       {"mass", get_particle_number<&World::mass>, "world:mass(id) -> m", "Mass (kg)."},
+      {"density", get_particle_number<&World::density>, "world:density(id) -> rho", "Density (kg/m^3)."},
       {"group_of", world_group_of, "world:group_of(id) -> group or nil", "The particle's rigid group."},
       {"set_position", set_particle_vec<&World::set_position>, "world:set_position(id, pos)", "Moves a particle."},
       {"set_velocity", set_particle_vec<&World::set_velocity>, "world:set_velocity(id, v)", "Sets a particle's velocity."},
@@ -256,6 +266,8 @@ std::span<const Function> world_particle_methods() {
       {"set_force", set_particle_vec<&World::set_applied_force>, "world:set_force(id, f)",
        "A constant external force on the particle, until set again ({0,0,0} removes it)."},
       {"set_radius", world_set_radius, "world:set_radius(id, r)", "Changes a radius; mass follows (density kept)."},
+      {"set_density", world_set_density, "world:set_density(id, rho)",
+       "Changes a density (kg/m^3); mass and inertia follow, and its group's. A quasi-static process may weigh its lightest particles more: a larger critical time step."},
       {"set_rotation_locked", world_set_rotation_locked, "world:set_rotation_locked(id, locked)",
        "Stops (true) or allows (false) the particle's rotation."},
       {"scale_radii", world_scale_radii, "world:scale_radii(factor)",

@@ -395,12 +395,16 @@ class World {
   Vec3 torque(std::int64_t id) const;
   double radius(std::int64_t id) const;
   double mass(std::int64_t id) const;
+  double density(std::int64_t id) const;
   int group_of(std::int64_t id) const;           // -1: not in a group
 
   void set_position(std::int64_t id, Vec3 x);
   void set_velocity(std::int64_t id, Vec3 v);
   void set_angular_velocity(std::int64_t id, Vec3 w);
   void set_radius(std::int64_t id, double r);    // keeps density: mass and inertia follow
+  // Mass and inertia follow (its rigid group's too). A quasi-static process may weigh its
+  // lightest particles more, which raises the critical time step [3-30] (genesis mass floor).
+  void set_density(std::int64_t id, double rho);
   void set_applied_force(std::int64_t id, Vec3 f);  // constant external force, until reset
   void set_rotation_locked(std::int64_t id, bool locked);
   // Multiply every radius by `factor` (radius expansion packing); masses follow.

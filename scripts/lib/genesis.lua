@@ -148,7 +148,8 @@ function M.install_stress(world, o)
     if o.log and updates % 25 == 0 then
       local t = {}
       for k = 1, #sets do t[k] = ("x %.5f: %.4g Pa"):format(f[k], p[k]) end
-      o.log("  stress installation, %d steps: %s; ratio %.2g", steps, table.concat(t, ", "), world:unbalanced_force_ratio())
+      o.log("  stress installation, %d steps: %s; ratio %.2g, dt %.3g s", steps, table.concat(t, ", "),
+            world:unbalanced_force_ratio(), world:dt())
     end
     if (settled >= settled_needed and world:unbalanced_force_ratio() <= ratio) or settled >= patience then break end
   end
@@ -317,7 +318,7 @@ function M.pack(world, o)
             min_contacts = true, floater_tag = true, progress = true, stages = true, stage_steps = true,
             max_steps = true, log = true, wall_contacts = true, split = true, sets_count = true,
             compaction_ratio = true, compaction_steps = true, patience = true, stress_ratio = true,
-            grow_floaters = true, shrink_gain = true}, "genesis.pack")
+            grow_floaters = true, shrink_gain = true, mass_floor = true}, "genesis.pack")
   assert(o.min and o.max and o.radii and o.box, "genesis.pack: min, max, radii and box are required")
   assert(o.stress and o.stress > 0, "genesis.pack: stress (Pa, > 0) is required")
   local log = o.log or function() end
@@ -329,7 +330,7 @@ function M.pack(world, o)
   local expanded = pack.expand(world, {min = o.min, max = o.max, inside = o.inside, radii = o.radii,
                                        seed = o.seed, walls = o.box, volume = o.volume, ratio = o.compaction_ratio or 1e-3,
                                        progress = o.progress, stages = o.stages, stage_steps = o.stage_steps,
-                                       max_steps = o.compaction_steps or 5000})
+                                       max_steps = o.compaction_steps or 5000, mass_floor = o.mass_floor})
   local first, last = expanded.first, expanded.last
   local volume = o.volume or (o.max[1] - o.min[1]) * (o.max[2] - o.min[2]) * (o.max[3] - o.min[3])
   -- The sets searched on their own: `split(x, y, z)` -> set index (the halves of a joint), or one.
@@ -347,8 +348,8 @@ function M.pack(world, o)
   end
   local p0 = {}
   for k = 1, nsets do p0[k] = world:contact_stress(k, volumes[k]) end
-  log("compacted %d particles without friction in %d steps: mean stress %s Pa, coordination %.2f",
-      last - first + 1, expanded.steps, table.concat((function() local t = {} for k, v in ipairs(p0) do t[k] = ("%.4g"):format(v) end return t end)(), " / "), expanded.coordination)
+  log("compacted %d particles without friction in %d steps: mean stress %s Pa, coordination %.2f, unbalanced-force ratio %.2g",
+      last - first + 1, expanded.steps, table.concat((function() local t = {} for k, v in ipairs(p0) do t[k] = ("%.4g"):format(v) end return t end)(), " / "), expanded.coordination, expanded.ratio)
   -- 2. The isotropic stress, by one radius factor per set, still without friction (unloading with
   -- friction to the low stress loses a third of the contacts: 32 % floaters, coordination 3.9, on
   -- the 1 cm REV).
@@ -361,6 +362,14 @@ function M.pack(world, o)
   log("stress installed: radii x %s, mean stress %s Pa (target %.4g) in %d steps, unbalanced-force ratio %.2g%s",
       table.concat(fs, " / "), table.concat(ps, " / "), o.stress, s.steps, s.ratio,
       s.reached and "" or " (NOT reached)")
+  -- The true masses back (pack.expand's mass floor): the state is an equilibrium, which they do
+  -- not enter.
+  if o.mass_floor and o.mass_floor > 0 then
+    local rho = world:settings().density
+    for id = first, last do
+      if world:density(id) ~= rho then world:set_density(id, rho) end
+    end
+  end
   -- 3. Floaters out. A particle's contacts with the region's walls count: one held by two
   -- neighbours against a wall is part of the jammed structure (its bonds will hold it once the
   -- wall goes, rotation locked).

@@ -144,7 +144,7 @@ function M.expand(world, o)
   local known = {min = true, max = true, inside = true, radii = true, seed = true, rng = true,
                  initial_scale = true, stages = true, stage_steps = true, ratio = true,
                  max_steps = true, walls = true, volume = true, density = true, attempts = true,
-                 progress = true}
+                 progress = true, mass_floor = true}
   for k in pairs(o) do
     if not known[k] then error("pack.expand: unknown option '" .. tostring(k) .. "'", 2) end
   end
@@ -159,6 +159,18 @@ function M.expand(world, o)
   local xyz = place(small, o.min, o.max, o.inside, rng, o.attempts or 1000)
   local before = world:particle_count()
   local first, last = world:add_particles(xyz, small, o.density)
+  -- `mass_floor` (m): a particle whose final radius is below it weighs as a sphere of that radius
+  -- (density raised by (floor / R)^3), as set_radius keeps densities. The critical time step
+  -- [3-30] is set by the lightest particles; a quasi-static packing ends in an equilibrium that
+  -- masses do not enter, so the caller restores the densities once it is packed.
+  if o.mass_floor and o.mass_floor > 0 then
+    for i = 1, #final do
+      if final[i] < o.mass_floor then
+        local id = first + i - 1
+        world:set_density(id, world:density(id) * (o.mass_floor / final[i]) ^ 3)
+      end
+    end
+  end
   local alone = before == 0   -- the world holds only these particles: scale_radii does it at once
   local steps = 0
   local factor = (1 / s0) ^ (1 / stages)

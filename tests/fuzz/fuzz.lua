@@ -173,6 +173,7 @@ W.set_velocity = function(w) return w:set_velocity(particle_id(w), vec(speed)) e
 W.set_angular_velocity = function(w) return w:set_angular_velocity(particle_id(w), vec(speed)) end
 W.set_force = function(w) return w:set_force(particle_id(w), vec(function() return (random() - 0.5) * 1e-4 end)) end
 W.set_radius = function(w) return w:set_radius(particle_id(w), num(radius)) end
+W.set_density = function(w) return w:set_density(particle_id(w), num(function() return 2500 end)) end
 W.scale_radii = function(w) return w:scale_radii(num(function() return 0.9 + 0.2 * random() end)) end
 W.set_rotation_locked = function(w) return w:set_rotation_locked(particle_id(w), chance(0.5)) end
 W.getters = function(w)

@@ -11,6 +11,9 @@ assert(f2 == 2 and l2 == 3)
 local f3, l3 = w:add_particles(asperity.array({0.09, 0, 0.05, 0.12, 0, 0.05}), {0.01, 0.012})
 assert(f3 == 4 and l3 == 5 and w:radius(5) == 0.012)
 assert(math.abs(w:mass(1) - 2000 * 4 / 3 * math.pi * 1e-6) < 1e-12, "density from the settings")
+w:set_density(1, 4000)
+assert(w:density(1) == 4000 and math.abs(w:mass(1) - 4000 * 4 / 3 * math.pi * 1e-6) < 1e-12, "mass follows the density")
+w:set_density(1, 2000)
 
 -- vectors
 local p = w:position(2)

@@ -52,6 +52,30 @@ TEST(TimeStep, EstimateIsSqrtMassOverContactStiffness) {
   EXPECT_NEAR(w.dt(), 0.8 * std::sqrt(m / (2 * 0.1)), 1e-15) << "automatic dt = 0.8 x estimate";
 }
 
+TEST(TimeStep, HeavierParticleRaisesTheEstimateBySqrtOfItsMass) {
+  // A light sphere between two heavy ones (each with one contact and a plane) sets the estimate;
+  // four times its density doubles its sqrt(m / k) [3-30], up to the next body's.
+  WorldSettings ws;
+  ws.contact.friction = 0;
+  World w(ws);
+  const auto heavy_a = w.add_particle({0, 0, 0}, 1e-3);
+  const auto light = w.add_particle({1.398e-3, 0, 0}, 0.4e-3);
+  const auto heavy_b = w.add_particle({2.796e-3, 0, 0}, 1e-3);
+  const double m = w.mass(light), k = 0.1;
+  EXPECT_NEAR(w.critical_dt(), std::sqrt(m / (2 * k)), 1e-15) << "two contacts of the light one";
+  w.set_density(light, 4 * w.density(light));
+  EXPECT_DOUBLE_EQ(w.mass(light), 4 * m);
+  EXPECT_NEAR(w.critical_dt(), 2 * std::sqrt(m / (2 * k)), 1e-15);
+  // Its group's mass follows.
+  const std::vector<std::int64_t> pair{heavy_a, heavy_b};
+  const int g = w.add_group(pair);
+  const double before = w.group_mass(g);
+  w.set_density(heavy_b, 2 * w.density(heavy_b));
+  EXPECT_DOUBLE_EQ(w.group_mass(g), before + w.mass(heavy_a));
+  EXPECT_THROW(w.set_density(light, 0.0), Error);
+  EXPECT_THROW(w.set_density(light, std::nan("")), Error);
+}
+
 TEST(TimeStep, ChainRunsStablyAtNinetyFivePercent) {
   World w = chain(20, false);
   const double est = w.critical_dt();

@@ -59,6 +59,7 @@ local function cache_file(P, s)
     mat.rev.rotation_lock_bonds, mat.rev.bond_shear_ratio, mat.rev.bond_radius_factor, P.bond_gap)
     .. (P.wall_friction ~= 0 and ("_f%.3g"):format(P.wall_friction) or "")
     .. (P.genesis_shrink_gain ~= 1 and ("_sg%.3g"):format(P.genesis_shrink_gain) or "")
+    .. (P.genesis_mass_floor ~= 0 and ("_mf%.3g"):format(P.genesis_mass_floor) or "")
   return P.cache .. "/joint_" .. key .. ".h5"
 end
 
@@ -101,6 +102,7 @@ local function build(run)
                              stress = P.genesis_stress, friction = mat.contact.friction,
                              min_contacts = mat.genesis.floater_contacts, floater_tag = LOST,
                              grow_floaters = mat.genesis.grow_floaters, shrink_gain = P.genesis_shrink_gain,
+                             mass_floor = P.genesis_mass_floor * mat.packing.mean_radius,
                              progress = P.progress, max_steps = P.pack_steps,
                              log = log,
                              split = function(x, y, z) return z < surface_z(x, y) and 1 or 2 end,

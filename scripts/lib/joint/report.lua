@@ -194,6 +194,7 @@ function M.write(run)
     inert_particles = world:inert_count(),
     escaped_particles = run.escaped_count,     -- debris thrown out of the specimen and taken out
     platen_particles = run.platen_particles,
+    mass_added = run.mass_added,                  -- the mass floor's share of the halves' mass (0: none)
     bonds = world:bond_count(),
     stress_scale = run.stress_scale,
     target_stress_pa = run.target_stress,
