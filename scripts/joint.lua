@@ -57,9 +57,10 @@ local P = params_lib.parse{
   {"shear", 5, unit = "mm", above = 0, doc = "shear displacement"},
   {"residual_window", 0.5, unit = "mm", above = 0, doc = "the residual stress is the mean over the last this much of the shear"},
   {"velocity", 1.5e-5, unit = "m/s", above = 0, doc = "shear velocity (perf/runtime_vs_error.lua: within 1 % of a 4x slower run)"},
-  {"speedup", 1, type = "integer", oneof = {1, 2, 4},
+  {"speedup", 0, type = "integer", oneof = {0, 1, 2, 4},
    doc = "after the peak the shear velocity may double at each record, up to this many times "
-      .. "`velocity`, while the specimen stays quasi-static (speedup_kinetic); 1: constant velocity; the elastic model only"},
+      .. "`velocity`, while the specimen stays quasi-static (speedup_kinetic); 1: constant velocity; the elastic model only "
+      .. "(0: by model, 4 elastic, 1 otherwise: perf/README.md, within 1 % of a 4x slower run)"},
   {"speedup_drop", 0.25, above = 0, max = 1,
    doc = "past the peak: the shear stress below (1 - this) x the highest so far (above it again, the velocity steps back)"},
   {"speedup_kinetic", 0.002, above = 0,
@@ -94,7 +95,7 @@ local P = params_lib.parse{
   {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "thesis definition [3-35]: the particle count of the genesis"},
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "isotropic stress installed before bonding (scenarios.md 1; model units)"},
   {"genesis_shrink_gain", 1, above = 0, max = 1, doc = "the stress servo's gain when it shrinks the radii, relative to when it grows them (< 1: fewer steps, a slightly different packing)"},
-  {"genesis_mass_floor", 0, min = 0, max = 2, doc = "while packing, particles smaller than this x mean radius weigh as one of it (a larger time step; 0: true masses)"},
+  {"genesis_mass_floor", mat.genesis.mass_floor, min = 0, max = 2, doc = "while packing, particles smaller than this x mean radius weigh as one of it (a larger time step; 0: true masses)"},
   {"bond_gap", 0, unit = "m", min = 0, doc = "largest gap bonded (0: the engine's default, 1e-3 x mean radius)"},
   {"tensile_strength", mat.rev.bond_tensile_strength, unit = "Pa", above = 0,
    doc = "fracture model: bond strength st (model units; the REV's calibrated one by default)"},
@@ -113,9 +114,10 @@ local P = params_lib.parse{
   {"dt_safety", 0, min = 0, max = 2,
    doc = "time step / critical estimate for closure and shear (0: 1.0 elastic and fracture, 0.8 rigid; above 1 only to study instability)"},
   {"skin", 0, unit = "m", min = 0, doc = "Verlet skin (0: 0.1 mean radius, the rigid model 0.4)"},
-  {"mass_floor", 0, min = 0, max = 2,
+  {"mass_floor", -1, min = -1, max = 2,
    doc = "elastic and fracture: particles smaller than this x mean radius weigh as one of it in the closure and shear "
-      .. "(the lightest set the critical time step; 0: true masses)"},
+      .. "(the lightest set the critical time step; 0: true masses; -1: by model, 0.75 elastic, 0 fracture until its "
+      .. "loading rate is calibrated)"},
   {"snapshots", "0,1,2.5,5", list = "number", unit = "mm", min = 0,
    doc = "shear displacements of the particle snapshots, within 0 .. shear (\"\": none; by default those "
          .. "within a shorter shear and its end)"},
@@ -136,6 +138,9 @@ local P = params_lib.parse{
          .. "and on SIGTERM; the same command resumes from it (0: never)"},
   {"stop_after", "", oneof = {"", "packing"}, doc = "packing: stop once the halves are packed, before bonding"},
   check = function(P, fail, given)
+    -- Defaults by model, chosen by perf/runtime_vs_error.lua (perf/README.md, "Run time against error").
+    if P.speedup == 0 then P.speedup = P.model == "elastic" and 4 or 1 end
+    if P.mass_floor < 0 then P.mass_floor = P.model == "elastic" and 0.75 or 0 end
     if P.residual_window >= P.shear then
       fail("shear", ("must exceed the residual window (residual_window = %g mm): the residual is the "
                      .. "mean over the last residual_window of the shear"):format(P.residual_window))

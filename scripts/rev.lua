@@ -61,7 +61,7 @@ local P = params_lib.parse{
   {"density", mat.density, unit = "kg/m^3", above = 0, doc = "particle density"},
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "isotropic stress the genesis installs before bonding (model units)"},
   {"genesis_shrink_gain", 1, above = 0, max = 1, doc = "the stress servo's gain when it shrinks the radii, relative to when it grows them"},
-  {"genesis_mass_floor", 0, min = 0, max = 2, doc = "while packing, particles smaller than this x mean radius weigh as one of it (0: true masses)"},
+  {"genesis_mass_floor", mat.genesis.mass_floor, min = 0, max = 2, doc = "while packing, particles smaller than this x mean radius weigh as one of it (0: true masses)"},
   {"floater_contacts", mat.genesis.floater_contacts, type = "integer", min = 0,
    doc = "particles with fewer contacts are floaters"},
   {"grow_floaters", mat.genesis.grow_floaters, doc = "floaters get the radius and place at which they touch four neighbours (else they are taken out)"},
@@ -141,7 +141,7 @@ local function make_packing()
   local g = genesis.pack(w, {min = lo, max = hi, radii = r, seed = P.seed, box = box, stress = P.genesis_stress,
                              friction = P.friction, ratio = P.ratio, min_contacts = P.floater_contacts,
                              grow_floaters = P.grow_floaters, shrink_gain = P.genesis_shrink_gain,
-                             mass_floor = P.genesis_mass_floor * P.mean_radius, log = log})
+                             mass_floor = P.genesis_mass_floor, mean_radius = P.mean_radius, log = log})
   local info = {n_particles = #g.kept, n_generated = n, genesis = g, box = box, kept = g.kept,
                 porosity_nominal = g.porosity_nominal, porosity_true = g.porosity_true,
                 mean_radius = g.mean_radius, coordination = g.coordination,

@@ -12,7 +12,10 @@
 --   1. compaction without friction (particles and region walls): centres placed at random at a
 --      tenth of the radii, radii grown in stages (pack.expand). A frictionless assembly jams
 --      denser than a frictional one and at a reproducible density, so the state below does not
---      depend on where a frictional packing happened to lock.
+--      depend on where a frictional packing happened to lock. Until the stress is installed (step
+--      2), particles below `mass_floor` (materials.lua genesis.mass_floor, 1) x `mean_radius`
+--      weigh as one of that radius: the lightest particles set the critical time step, and the
+--      packed state is an equilibrium, which masses do not enter (2.5x the step).
 --   2. a low isotropic stress installed by scaling the radii by one factor (M.install_stress, a
 --      servo) until the mean stress of the assembly (from its contacts, world:contact_stress) is
 --      `stress`; with `split(x, y, z)` -> 1..sets_count, each set (the halves of a joint) has its
@@ -318,19 +321,23 @@ function M.pack(world, o)
             min_contacts = true, floater_tag = true, progress = true, stages = true, stage_steps = true,
             max_steps = true, log = true, wall_contacts = true, split = true, sets_count = true,
             compaction_ratio = true, compaction_steps = true, patience = true, stress_ratio = true,
-            grow_floaters = true, shrink_gain = true, mass_floor = true}, "genesis.pack")
+            grow_floaters = true, shrink_gain = true, mass_floor = true, mean_radius = true}, "genesis.pack")
   assert(o.min and o.max and o.radii and o.box, "genesis.pack: min, max, radii and box are required")
   assert(o.stress and o.stress > 0, "genesis.pack: stress (Pa, > 0) is required")
   local log = o.log or function() end
   local t0 = asperity.wall_time()
   local ratio = o.ratio or 1e-4
+  -- Until the stress is installed, particles below mass_floor x the mean radius (the packing's
+  -- nominal one) weigh as one of it (pack.expand): a longer time step for an end state that masses
+  -- do not enter.
+  local floor = (o.mass_floor or mat.genesis.mass_floor) * (o.mean_radius or mat.packing.mean_radius)
   -- 1. Frictionless compaction.
   world:set_friction(0)
   -- The compaction need not settle finely: the stress installation that follows does.
   local expanded = pack.expand(world, {min = o.min, max = o.max, inside = o.inside, radii = o.radii,
                                        seed = o.seed, walls = o.box, volume = o.volume, ratio = o.compaction_ratio or 1e-3,
                                        progress = o.progress, stages = o.stages, stage_steps = o.stage_steps,
-                                       max_steps = o.compaction_steps or 5000, mass_floor = o.mass_floor})
+                                       max_steps = o.compaction_steps or 5000, mass_floor = floor})
   local first, last = expanded.first, expanded.last
   local volume = o.volume or (o.max[1] - o.min[1]) * (o.max[2] - o.min[2]) * (o.max[3] - o.min[3])
   -- The sets searched on their own: `split(x, y, z)` -> set index (the halves of a joint), or one.
@@ -364,7 +371,7 @@ function M.pack(world, o)
       s.reached and "" or " (NOT reached)")
   -- The true masses back (pack.expand's mass floor): the state is an equilibrium, which they do
   -- not enter.
-  if o.mass_floor and o.mass_floor > 0 then
+  if floor > 0 then
     local rho = world:settings().density
     for id = first, last do
       if world:density(id) ~= rho then world:set_density(id, rho) end

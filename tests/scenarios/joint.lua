@@ -1,7 +1,8 @@
 -- The joint scenario (scripts/joint.lua) at a tiny size (8 mm square, 2 mm halves, ~200 particles):
 -- it runs end to end for the rigid and elastic models, writes its files, closes the energy ledger,
 -- and orders two surfaces of the study as the spec expects (scenarios.md 7: the roughest, S5,
--- peaks higher than the smoothest, S4; rigid, same seed, so the same hills and holes).
+-- peaks higher than the smoothest, S4, on the mean of five packings; rigid, same seeds, so the
+-- same hills and holes).
 local out = assert(params.out, "give out=DIRECTORY")
 local cache = out .. "/cache"
 local function joint(p)
@@ -15,17 +16,31 @@ end
 local s4 = joint{surface = "S4", model = "rigid", out = out .. "/S4_rigid"}
 local s5 = joint{surface = "S5", model = "rigid", out = out .. "/S5_rigid"}
 assert(s4.inert_particles > 0, "rigid model: the interior of the halves is not simulated")
-assert(s5.peak_shear_stress_mpa > s4.peak_shear_stress_mpa,
-       ("S5 peak %.3g MPa must exceed S4 peak %.3g MPa"):format(s5.peak_shear_stress_mpa, s4.peak_shear_stress_mpa))
-assert(s5.max_dilatancy_mm > s4.max_dilatancy_mm, "S5 dilates more than S4")
+-- The roughest surface peaks higher than the smoothest on the mean of five packings (seeds 1-5,
+-- each surface with the same seed). At 8 mm one packing orders them either way (the S5 / S4 peak
+-- ratio ranged 0.6-2.3 over these seeds, on the genesis of true masses and on the current one),
+-- and the dilatancy, set here by the particles more than by the surface, does not order even on
+-- the mean of five (0.56 against 0.57 mm with true masses): the study checks it at its size.
+do
+  local p4, p5 = s4.peak_shear_stress_mpa, s5.peak_shear_stress_mpa
+  for seed = 2, 5 do
+    p4 = p4 + joint{surface = "S4", model = "rigid", seed = seed, snapshots = "1", out = out .. "/S4_rigid_" .. seed}.peak_shear_stress_mpa
+    p5 = p5 + joint{surface = "S5", model = "rigid", seed = seed, snapshots = "1", out = out .. "/S5_rigid_" .. seed}.peak_shear_stress_mpa
+  end
+  assert(p5 > p4, ("S5 mean peak %.3g MPa must exceed S4's %.3g MPa (seeds 1-5)"):format(p5 / 5, p4 / 5))
+end
 
-local el = joint{surface = "S1", model = "elastic", out = out .. "/S1_elastic"}
+local el = joint{surface = "S1", model = "elastic", speedup = 1, out = out .. "/S1_elastic"}
+-- The elastic model's defaults by model: the mass floor 0.75 (the lightest particles weigh more).
+assert(el.parameters.mass_floor == 0.75 and el.mass_added > 0 and el.mass_added < 0.05,
+       ("elastic: mass floor %s adds %s of the mass"):format(el.parameters.mass_floor, el.mass_added))
 
--- speedup (the loading rate adapting to the state): the same elastic joint, the velocity allowed
--- to rise to 4x past the peak. It rises only after the constant-velocity run's peak, the shear
--- takes fewer steps, the records stay as far apart as at constant velocity (not 4x: the checks run
--- more often) and the run ends at `shear`.
-local fast = joint{surface = "S1", model = "elastic", speedup = 4, out = out .. "/S1_elastic_speedup"}
+-- speedup (the loading rate adapting to the state; the elastic model's default, 4): the same
+-- elastic joint, the velocity allowed to rise to 4x past the peak. It rises only after the
+-- constant-velocity run's peak, the shear takes fewer steps, the records stay as far apart as at
+-- constant velocity (not 4x: the checks run more often) and the run ends at `shear`.
+local fast = joint{surface = "S1", model = "elastic", out = out .. "/S1_elastic_speedup"}
+assert(fast.parameters.speedup == 4, "speedup 4 is the elastic model's default")
 assert(fast.speedup_max > 1 and el.speedup_max == 1, ("speedup_max %s"):format(fast.speedup_max))
 assert(fast.speedup_from_mm >= el.peak_displacement_mm,
        ("the velocity rose at %.3f mm, before the peak at %.3f mm"):format(fast.speedup_from_mm, el.peak_displacement_mm))
@@ -72,7 +87,7 @@ assert(el.overlaps_small == (el.overlap_ratio_max <= el.parameters.overlap_limit
 
 -- The same joint with its overlap limit set below what the joint reaches: it must say that it was
 -- crossed, and, the limit being a warning's threshold, leave every result as it was.
-local low = joint{surface = "S1", model = "elastic", overlap_limit = 0.05, out = out .. "/S1_elastic_low_limit"}
+local low = joint{surface = "S1", model = "elastic", speedup = 1, overlap_limit = 0.05, out = out .. "/S1_elastic_low_limit"}
 assert(low.overlap_ratio_max > 0.05 and low.overlaps_small == false,
        ("overlap_limit 0.05: overlap_ratio_max %.3g, overlaps_small %s"):format(low.overlap_ratio_max, tostring(low.overlaps_small)))
 for _, key in ipairs{"peak_shear_stress_mpa", "residual_shear_stress_mpa", "max_dilatancy_mm", "overlap_ratio_max"} do
@@ -83,6 +98,7 @@ end
 -- strength check passes): bonds break while shearing, the energy they held is booked as
 -- released, so the ledger still closes.
 local fr = joint{surface = "S1", model = "fracture", out = out .. "/S1_fracture"}
+assert(fr.parameters.speedup == 1 and fr.mass_added == 0, "the fracture model keeps its velocity and true masses")
 assert(fr.broken_bonds > 0, "the fracture model breaks bonds")
 assert(fr.energy_shares and math.abs(fr.energy_balance_error) < 0.01,
        ("fracture: energy balance error %.3g of the input work"):format(fr.energy_balance_error))
@@ -106,13 +122,20 @@ do  -- a sample every 50 steps from the shear's start to (nearly) its end
 end
 
 -- The shear box (box=sides, the default): the side layers join the platens, except within
--- box_clearance of the joint, where the halves touch only through bonded particles.
-local free_sides = joint{surface = "S1", model = "elastic", box = "none", shear = 0.2, residual_window = 0.1, snapshots = "",
-                         out = out .. "/S1_free_sides"}
+-- box_clearance of the joint, where the halves touch only through bonded particles. Platens of
+-- 1 mm: with the default 1.5 mm, 3 mm halves leave the side layers next to no room between the
+-- platen and box_clearance (1 mm) above the surface.
+local short = {surface = "S1", model = "elastic", platen = 0.001, shear = 0.2, residual_window = 0.1, snapshots = ""}
+local function short_run(box, name)
+  local p = {box = box, out = out .. "/" .. name}
+  for k, v in pairs(short) do p[k] = v end
+  return joint(p)
+end
+local boxed_sides, free_sides = short_run("sides", "S1_boxed_sides"), short_run("none", "S1_free_sides")
 for _, half in ipairs{"lower", "upper"} do
-  local boxed, plain = el.platen_particles[half], free_sides.platen_particles[half]
+  local boxed, plain = boxed_sides.platen_particles[half], free_sides.platen_particles[half]
   assert(boxed > plain, ("%s platen: %d particles with the box, %d without"):format(half, boxed, plain))
-  assert(boxed < el["n_" .. half], ("%s platen: %d of %d particles, none left free"):format(half, boxed, el["n_" .. half]))
+  assert(boxed < boxed_sides["n_" .. half], ("%s platen: %d of %d particles, none left free"):format(half, boxed, boxed_sides["n_" .. half]))
 end
 for _, f in ipairs{"summary.json", "shear.csv", "shear.h5", "closure.csv", "closure.h5", "joint.xdmf",
                    "joint_closure.xdmf", "shear_stress.png", "normal_stress.png", "closure.png", "energies.png",

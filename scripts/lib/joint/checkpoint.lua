@@ -27,6 +27,9 @@ local VERSION = 1
 -- others.
 local FREE = {threads = true, genesis_threads = true, progress = true, checkpoint_every = true, cache = true,
               save = true, out = true}
+-- Parameters joint.lua gained after states were saved: a state saved without one was made with
+-- this value (the behaviour before it existed), so it resumes where that value is given.
+local MADE_WITHOUT = {mass_floor = 0, genesis_mass_floor = 0}
 -- The run's fields (joint/context.lua) that the closure and the shear change and the report reads.
 local RUN_FIELDS = {"ramp_steps", "moved_steps", "overlap_max", "overlap_at", "escaped_count", "escape_box",
                     "z_contact", "normal_stiffness", "applied_z", "axis", "c0", "e0", "dynamic_ratio",
@@ -140,10 +143,12 @@ function M.find(run)
       for k in pairs(state.parameters) do if now[k] == nil and not FREE[k] then names[#names + 1] = k end end
       table.sort(names)
       for _, k in ipairs(names) do
-        if now[k] ~= state.parameters[k] then
+        local was = state.parameters[k]
+        if was == nil then was = MADE_WITHOUT[k] end
+        if now[k] ~= was then
           error(("out=%s holds a run saved with %s=%s, not %s: give the same parameters to resume it, or "
                  .. "remove %s (or give another out=) to start afresh"):format(P.out, k,
-                 tostring(state.parameters[k]), tostring(now[k]), path), 0)
+                 tostring(was), tostring(now[k]), path), 0)
         end
       end
       state.path = path

@@ -102,7 +102,7 @@ local function build(run)
                              stress = P.genesis_stress, friction = mat.contact.friction,
                              min_contacts = mat.genesis.floater_contacts, floater_tag = LOST,
                              grow_floaters = mat.genesis.grow_floaters, shrink_gain = P.genesis_shrink_gain,
-                             mass_floor = P.genesis_mass_floor * mat.packing.mean_radius,
+                             mass_floor = P.genesis_mass_floor,
                              progress = P.progress, max_steps = P.pack_steps,
                              log = log,
                              split = function(x, y, z) return z < surface_z(x, y) and 1 or 2 end,
