@@ -140,6 +140,24 @@ function M.refresh_dt(world)
   if world:settings().dt == 0 then world:set_dt(0) end
 end
 
+-- The mass floor (model.md 3): the particles `ids` whose radius (radii[k] for ids[k], or their
+-- current one) is below `floor` weigh as a sphere of radius `floor`: their density is raised by
+-- (floor / R)^3 (set_radius keeps densities). The lightest particles set the critical time step
+-- [3-30]; where the motion is quasi-static they need not be that light. Returns the mass added and
+-- the particles' mass before.
+function M.floor_masses(world, ids, floor, radii)
+  local added, total = 0, 0
+  for k, id in ipairs(ids) do
+    local r, m = radii and radii[k] or world:radius(id), world:mass(id)
+    total = total + m
+    if r < floor then
+      world:set_density(id, world:density(id) * (floor / r) ^ 3)
+      added = added + world:mass(id) - m
+    end
+  end
+  return added, total
+end
+
 function M.expand(world, o)
   local known = {min = true, max = true, inside = true, radii = true, seed = true, rng = true,
                  initial_scale = true, stages = true, stage_steps = true, ratio = true,
@@ -159,17 +177,12 @@ function M.expand(world, o)
   local xyz = place(small, o.min, o.max, o.inside, rng, o.attempts or 1000)
   local before = world:particle_count()
   local first, last = world:add_particles(xyz, small, o.density)
-  -- `mass_floor` (m): a particle whose final radius is below it weighs as a sphere of that radius
-  -- (density raised by (floor / R)^3), as set_radius keeps densities. The critical time step
-  -- [3-30] is set by the lightest particles; a quasi-static packing ends in an equilibrium that
+  -- `mass_floor` (m), on the final radii: a quasi-static packing ends in an equilibrium that
   -- masses do not enter, so the caller restores the densities once it is packed.
   if o.mass_floor and o.mass_floor > 0 then
-    for i = 1, #final do
-      if final[i] < o.mass_floor then
-        local id = first + i - 1
-        world:set_density(id, world:density(id) * (o.mass_floor / final[i]) ^ 3)
-      end
-    end
+    local ids = {}
+    for i = 1, #final do ids[i] = first + i - 1 end
+    M.floor_masses(world, ids, o.mass_floor, final)
   end
   local alone = before == 0   -- the world holds only these particles: scale_radii does it at once
   local steps = 0

@@ -10,6 +10,7 @@
 -- The platens' rule (the layers of the halves' faces, the box sides stopping short of the joint
 -- surface) is the joint's own: lib/specimen.lua's platens are the top and bottom layers of one body.
 local mat = require("materials")
+local pack = require("pack")
 
 local M = {}
 
@@ -62,18 +63,9 @@ local function bonded(run)
   run.mass_added = 0
   if P.mass_floor > 0 then
     local floor = P.mass_floor * mat.packing.mean_radius
-    local total, added = 0, 0
-    for _, half in ipairs{run.lower, run.upper} do
-      for _, id in ipairs(half) do
-        local m, r = world:mass(id), rad[id]
-        total = total + m
-        if r < floor then
-          world:set_density(id, world:density(id) * (floor / r) ^ 3)
-          added = added + world:mass(id) - m
-        end
-      end
-    end
-    run.mass_added = added / total
+    local added_lower, total_lower = pack.floor_masses(world, run.lower, floor)
+    local added_upper, total_upper = pack.floor_masses(world, run.upper, floor)
+    run.mass_added = (added_lower + added_upper) / (total_lower + total_upper)
     run:log("mass floor: particles below %.3g mm weigh as one of that radius (+%.1f %% of the mass)",
             floor * 1e3, 100 * run.mass_added)
   end
