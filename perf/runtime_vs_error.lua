@@ -37,7 +37,7 @@ local P = require("params").defaults{
   reference = "strict", -- strict: velocity / 4, dt 0.5, records / 4; slower: velocity / 4 only (scenarios.md 6's "a run 4x slower")
   seed = 1,            -- the joint's packing seed
   genesis_mass_floor = require("materials").genesis.mass_floor,   -- the joint's packing (0: the packing of true masses)
-  joint = "",          -- more key=value parameters for every joint run, space-separated (e.g. tensile_strength=0.0301)
+  joint = "",          -- more key=value parameters for every run of the scene's script, space-separated (e.g. tensile_strength=0.0301)
   reuse = false,       -- true: a setting whose folder holds the summary.json of a finished run with its parameters is read, not run again
   only = "",           -- comma-separated setting names (default: all)
   out = "out/runtime_vs_error",
