@@ -101,20 +101,13 @@ int world_group_of(lua_State* L) {
   });
 }
 
-int world_set_radius(lua_State* L) {
+// world:set_X(id, value) for a per-particle number (radius, density).
+template <void (World::*Set)(std::int64_t, double)>
+int set_particle_number(lua_State* L) {
   return guarded(L, [&] {
     World& w = world_arg(L);
     std::int64_t id = particle_arg(L, 2, w);
-    w.set_radius(id, check_number(L, 3));
-    return 0;
-  });
-}
-
-int world_set_density(lua_State* L) {
-  return guarded(L, [&] {
-    World& w = world_arg(L);
-    std::int64_t id = particle_arg(L, 2, w);
-    w.set_density(id, check_number(L, 3));
+    (w.*Set)(id, check_number(L, 3));
     return 0;
   });
 }
@@ -265,8 +258,8 @@ std::span<const Function> world_particle_methods() {
        "world:set_angular_velocity(id, w)", "Sets a particle's angular velocity."},
       {"set_force", set_particle_vec<&World::set_applied_force>, "world:set_force(id, f)",
        "A constant external force on the particle, until set again ({0,0,0} removes it)."},
-      {"set_radius", world_set_radius, "world:set_radius(id, r)", "Changes a radius; mass follows (density kept)."},
-      {"set_density", world_set_density, "world:set_density(id, rho)",
+      {"set_radius", set_particle_number<&World::set_radius>, "world:set_radius(id, r)", "Changes a radius; mass follows (density kept)."},
+      {"set_density", set_particle_number<&World::set_density>, "world:set_density(id, rho)",
        "Changes a density (kg/m^3); mass and inertia follow, and its group's. A quasi-static process may weigh its lightest particles more: a larger critical time step."},
       {"set_rotation_locked", world_set_rotation_locked, "world:set_rotation_locked(id, locked)",
        "Stops (true) or allows (false) the particle's rotation."},
