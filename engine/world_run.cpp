@@ -147,8 +147,7 @@ void World::set_overlap_limit(double r) {
   state_->settings.overlap_limit = r;
 }
 void World::set_skin(double skin) {
-  // 0 (automatic) is the first build's choice: a running world keeps a skin.
-  require(skin != 0, "set_skin: skin must be > 0 (0, automatic, is only for a new world)");
+  // 0: automatic again, derived from the radii at the next build (as scale_radii does).
   check_setting("set_skin", "skin", skin);
   state_->settings.skin = skin;
   state_->skin = skin;

@@ -36,7 +36,7 @@ local P = params_lib.parse{
   {"contact_bond_friction", mat.rev.contact_bond_friction, min = 0, doc = "passed to rev.lua"},
   {"grow_floaters", mat.genesis.grow_floaters, doc = "passed to rev.lua"},
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "passed to rev.lua"},
-  {"genesis_shrink_gain", 1, above = 0, max = 1, doc = "passed to rev.lua"},
+  {"genesis_shrink_gain", mat.genesis.shrink_gain, above = 0, max = 1, doc = "passed to rev.lua"},
   {"genesis_mass_floor", mat.genesis.mass_floor, min = 0, max = 2, doc = "passed to rev.lua"},
   {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "passed to rev.lua"},
   {"out", "out/calibration", nonempty = true, doc = "output folder (one folder per trial and seed)"},

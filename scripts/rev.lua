@@ -60,7 +60,7 @@ local P = params_lib.parse{
   {"damping", mat.damping, min = 0, below = 1, doc = "local damping"},
   {"density", mat.density, unit = "kg/m^3", above = 0, doc = "particle density"},
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "isotropic stress the genesis installs before bonding (model units)"},
-  {"genesis_shrink_gain", 1, above = 0, max = 1, doc = "the stress servo's gain when it shrinks the radii, relative to when it grows them"},
+  {"genesis_shrink_gain", mat.genesis.shrink_gain, above = 0, max = 1, doc = "the stress servo's gain when it shrinks the radii, relative to when it grows them"},
   {"genesis_mass_floor", mat.genesis.mass_floor, min = 0, max = 2, doc = "while packing, particles smaller than this x mean radius weigh as one of it (0: true masses)"},
   {"floater_contacts", mat.genesis.floater_contacts, type = "integer", min = 0,
    doc = "particles with fewer contacts are floaters"},
@@ -144,7 +144,7 @@ local function make_packing()
                              mass_floor = P.genesis_mass_floor, mean_radius = P.mean_radius, log = log})
   local info = {n_particles = #g.kept, n_generated = n, genesis = g, box = box, kept = g.kept,
                 porosity_nominal = g.porosity_nominal, porosity_true = g.porosity_true,
-                mean_radius = g.mean_radius, coordination = g.coordination,
+                mean_radius = g.mean_radius, coordination = g.coordination, interior = g.interior,
                 wall_stress_pa = g.wall_stress_pa}
   local rr = {}
   local all = w:radii()
@@ -158,7 +158,7 @@ end
 local function cached_packing()
   if P.cache == "" then return make_packing() end
   asperity.mkdir(P.cache)
-  local key = ("rev_v3_L%.6g_n%.6g_s%d_r%.6g_%.6g_k%.6g_%.6g_d%.6g_%.6g_g%.6g_f%d_q%.6g"):format(P.size, P.porosity,
+  local key = ("rev_v4_L%.6g_n%.6g_s%d_r%.6g_%.6g_k%.6g_%.6g_d%.6g_%.6g_g%.6g_f%d_q%.6g"):format(P.size, P.porosity,
     P.seed, P.mean_radius, P.radius_sd, P.kn, P.ks, P.damping, P.density, P.genesis_stress, P.floater_contacts, P.ratio)
     .. (P.lock_rotation and ("_l%d"):format(P.rotation_lock_bonds) or "_free") .. (P.grow_floaters and "_grown" or "")
     .. (P.genesis_shrink_gain ~= 1 and ("_sg%.3g"):format(P.genesis_shrink_gain) or "")
@@ -546,7 +546,8 @@ local summary = {
              floaters_grown = packing.genesis.floaters_grown, floater_share = packing.genesis.floater_share,
              stress_pa = packing.genesis.stress_pa, stress_target_pa = P.genesis_stress,
              stress_reached = packing.genesis.stress_reached, radius_factor = packing.genesis.radius_factor,
-             coordination = packing.genesis.coordination, steps = packing.genesis.steps,
+             coordination = packing.genesis.coordination, interior = packing.genesis.interior,
+             steps = packing.genesis.steps,
              seconds = packing.genesis.seconds, porosity_nominal = packing.porosity_nominal,
              porosity_true = packing.porosity_true},
   bond_stress_max_over_st = residual.max_over_st, bond_stress_p999_over_st = residual.p999_over_st,

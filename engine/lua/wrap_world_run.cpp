@@ -269,7 +269,7 @@ std::span<const Function> world_run_methods() {
       {"set_dt", set_world_number<&World::set_dt>, "world:set_dt(dt)", "Fixes the time step (0: automatic again)."},
       {"set_dt_safety", set_world_number<&World::set_dt_safety>, "world:set_dt_safety(f)",
        "Automatic time step = f x the critical estimate (default 0.8; 0.001 <= f <= 2)."},
-      {"set_skin", set_world_number<&World::set_skin>, "world:set_skin(m)", "Verlet skin in m (the list is rebuilt)."},
+      {"set_skin", set_world_number<&World::set_skin>, "world:set_skin(m)", "Verlet skin in m (the list is rebuilt); 0: automatic again, 0.4 x the mean radius at the next build."},
       {"set_rotation_lock_bonds", set_world_number<&World::set_rotation_lock_bonds>, "world:set_rotation_lock_bonds(k)",
        "A particle with a bond does not rotate; once one of its bonds broke, only while it holds k\n"
        "(1: the thesis's rule, every bonded particle locked; model.md 2)."},

@@ -507,7 +507,7 @@ class World {
   double dt() const;                      // the step in use
   void set_dt(double dt);                 // fix it (0: back to automatic)
   void set_dt_safety(double f);           // automatic dt = f x estimate (0 < f <= 2)
-  void set_skin(double skin);             // Verlet skin, m (> 0); the list is rebuilt
+  void set_skin(double skin);             // Verlet skin, m (0: automatic); the list is rebuilt
   void set_overlap_limit(double r);       // health check's deepest overlap / smaller radius, (0, 2)
   // The rotation lock's count rule (WorldSettings::rotation_lock_bonds; 1: the thesis's rule, a
   // particle holding a bond does not rotate), applied at once.

@@ -27,6 +27,10 @@
 --      specimen: made inert, fixed, and tagged `floater_tag` if given. Wall contacts are counted
 --      by `wall_contacts(x, y, z, r)` (default: the faces of the box min..max).
 --   4. the particles' friction restored (world:set_friction); the walls stay frictionless.
+--      The state (floater share, porosity, coordination) is reported over the specimen and over
+--      its interior: the particles whose centres lie 3 mean radii or more from its walls (the
+--      box, or `interior(x, y, z, margin)` if given), where the walls' layering does not reach, so that
+--      specimens of different sizes and shapes compare as materials.
 -- bond:
 --   5. bonds installed in each id set on its own (model.md 5: contacts keep their forces, beams
 --      start at zero), the walls removed, the assembly cycled to equilibrium.
@@ -97,10 +101,11 @@ end
 -- the true one, which relaxes non-affinely, so the loop does not overshoot), at most `max_change`
 -- per update. Sets that do not touch (the halves of a joint, apart behind the mould) are servoed
 -- side by side. Near the jamming point a frictionless packing relaxes slowly; the servo follows
--- the relaxation instead of waiting for an equilibrium at each trial factor. `shrink_gain` (< 1)
--- shrinks more gently than it grows, so that a set above the target comes down to it with the
--- relaxation instead of overshooting below and creeping back up (perf/README.md: 2-3.8x fewer
--- steps on 2 and 5 cm joints; not the default yet). Done when every set
+-- the relaxation instead of waiting for an equilibrium at each trial factor. `shrink_gain` (< 1;
+-- genesis.pack's default materials.lua genesis.shrink_gain, 1/4) shrinks more gently than it
+-- grows, so that a set above the target comes down to it with the relaxation instead of
+-- overshooting below and creeping back up (perf/README.md: 1.4-5.8x fewer steps on 5 cm joints,
+-- the same floater share and coordination on average over seeds). Done when every set
 -- is within `tolerance` of the target at `settled` updates running and the unbalanced-force
 -- ratio is below `ratio`, or, where the assembly creeps without settling that far, at `patience`
 -- updates running within the tolerance (the ratio reached is reported: the bonds are installed in
@@ -321,7 +326,8 @@ function M.pack(world, o)
             min_contacts = true, floater_tag = true, progress = true, stages = true, stage_steps = true,
             max_steps = true, log = true, wall_contacts = true, split = true, sets_count = true,
             compaction_ratio = true, compaction_steps = true, patience = true, stress_ratio = true,
-            grow_floaters = true, shrink_gain = true, mass_floor = true, mean_radius = true}, "genesis.pack")
+            grow_floaters = true, shrink_gain = true, mass_floor = true, mean_radius = true,
+            interior = true}, "genesis.pack")
   assert(o.min and o.max and o.radii and o.box, "genesis.pack: min, max, radii and box are required")
   assert(o.stress and o.stress > 0, "genesis.pack: stress (Pa, > 0) is required")
   local log = o.log or function() end
@@ -355,19 +361,19 @@ function M.pack(world, o)
   end
   local p0 = {}
   for k = 1, nsets do p0[k] = world:contact_stress(k, volumes[k]) end
-  log("compacted %d particles without friction in %d steps: mean stress %s Pa, coordination %.2f, unbalanced-force ratio %.2g",
-      last - first + 1, expanded.steps, table.concat((function() local t = {} for k, v in ipairs(p0) do t[k] = ("%.4g"):format(v) end return t end)(), " / "), expanded.coordination, expanded.ratio)
+  log("compacted %d particles without friction in %d steps (%d neighbour builds): mean stress %s Pa, coordination %.2f, unbalanced-force ratio %.2g",
+      last - first + 1, expanded.steps, world:stats().rebuilds, table.concat((function() local t = {} for k, v in ipairs(p0) do t[k] = ("%.4g"):format(v) end return t end)(), " / "), expanded.coordination, expanded.ratio)
   -- 2. The isotropic stress, by one radius factor per set, still without friction (unloading with
   -- friction to the low stress loses a third of the contacts: 32 % floaters, coordination 3.9, on
   -- the 1 cm REV).
   local s = M.install_stress(world, {sets = sets, tags = tags, volumes = volumes, target = o.stress,
                                      tolerance = o.tolerance, ratio = o.stress_ratio or mat.genesis.ratio, max_steps = o.max_steps, patience = o.patience,
-                                     shrink_gain = o.shrink_gain,
+                                     shrink_gain = o.shrink_gain or mat.genesis.shrink_gain,
                                      log = o.progress and log or nil})
   local fs, ps = {}, {}
   for k = 1, nsets do fs[k], ps[k] = ("%.5f"):format(s.factors[k]), ("%.4g"):format(s.stresses[k]) end
-  log("stress installed: radii x %s, mean stress %s Pa (target %.4g) in %d steps, unbalanced-force ratio %.2g%s",
-      table.concat(fs, " / "), table.concat(ps, " / "), o.stress, s.steps, s.ratio,
+  log("stress installed: radii x %s, mean stress %s Pa (target %.4g) in %d steps (%d neighbour builds so far), unbalanced-force ratio %.2g%s",
+      table.concat(fs, " / "), table.concat(ps, " / "), o.stress, s.steps, world:stats().rebuilds, s.ratio,
       s.reached and "" or " (NOT reached)")
   -- The true masses back (pack.expand's mass floor): the state is an equilibrium, which they do
   -- not enter.
@@ -422,6 +428,26 @@ function M.pack(world, o)
   if #grown > 0 then counts = M.touching_counts(world, kept) end
   local contacts = 0
   for _, id in ipairs(kept) do contacts = contacts + (counts[id] or 0) end
+  -- The same figures away from the walls (the material, not its boundary layers).
+  local margin = 3 * (o.mean_radius or mat.packing.mean_radius)
+  local interior = o.interior or function(x, y, z, m)
+    return x - lo[1] >= m and hi[1] - x >= m and y - lo[2] >= m and hi[2] - y >= m
+       and z - lo[3] >= m and hi[3] - z >= m
+  end
+  local taken_out, placed = {}, {}
+  for _, id in ipairs(floaters) do taken_out[id] = true end
+  for _, id in ipairs(grown) do placed[id] = true end
+  local within, within_kept, within_floaters, within_contacts = 0, 0, 0, 0
+  local now = world:positions()
+  for id = first, last do
+    if interior(now:get(id, 1), now:get(id, 2), now:get(id, 3), margin) then
+      within = within + 1
+      if taken_out[id] or placed[id] then within_floaters = within_floaters + 1 end
+      if not taken_out[id] then
+        within_kept, within_contacts = within_kept + 1, within_contacts + (counts[id] or 0)
+      end
+    end
+  end
   local res = {
     particles = last - first + 1, kept = kept, floaters = floaters, floaters_removed = #floaters,
     floaters_grown = #grown, floater_share = (#floaters + #grown) / math.max(1, last - first + 1),
@@ -432,10 +458,14 @@ function M.pack(world, o)
     wall_stress_pa = pack.box_wall_stresses(world, o.box, o.min, o.max),
     coordination = contacts / math.max(1, #kept),   -- ball-ball contacts per kept particle
     porosity_nominal = nominal, porosity_true = true_n, mean_radius = mean,
+    interior = {margin = margin, particles = within, floater_share = within_floaters / math.max(1, within),
+                coordination = within_contacts / math.max(1, within_kept)},
     seconds = asperity.wall_time() - t0,
   }
   log("genesis state: %d particles (%d floaters placed touching four, %d out), coordination %.2f, porosity %.3f (thesis definition) / %.3f (true), mean radius %.4g mm",
       #kept, #grown, #floaters, res.coordination, nominal, true_n, mean * 1e3)
+  log("genesis state %.3g mm from the walls: %d particles, floaters %.1f %%, coordination %.2f",
+      margin * 1e3, within, 100 * res.interior.floater_share, res.interior.coordination)
   return res
 end
 

@@ -19,11 +19,14 @@
 -- in the region (the box min..max, cut by `inside(x, y, z, r)` if given, e.g. the side of a mould),
 -- not overlapping one another at the initial radii (the final ones times initial_scale, 1/10);
 -- then the radii grow in `stages` (40) equal factors, cycling `stage_steps` (250) steps after each
--- (small steps: a light particle squeezed by a large growth step is shot away); then
--- the assembly cycles until the unbalanced-force ratio (mean unbalanced / mean contact force,
--- PFC's) is below `ratio` (1e-4). The region must be closed by walls the caller made. Returns
--- {first, last, steps, ratio, seconds, porosity_nominal, porosity_true, mean_radius, contacts,
--- coordination, wall_stress (with `walls` from walls.box: name -> Pa, compression positive)}.
+-- (small steps: a light particle squeezed by a large growth step is shot away), with the Verlet
+-- skin the final radii would get (an automatic skin follows the growing radii, and at a tenth of
+-- them a step's travel exceeds it: a neighbour build every 3-4 steps, against every 9 with this
+-- one; the world's own skin, if set, is kept); then the assembly cycles until the
+-- unbalanced-force ratio (mean unbalanced / mean contact force, PFC's) is below `ratio` (1e-4).
+-- The region must be closed by walls the caller made. Returns {first, last, steps, ratio, seconds,
+-- porosity_nominal, porosity_true, mean_radius, contacts, coordination, wall_stress (with `walls`
+-- from walls.box: name -> Pa, compression positive)}.
 -- The porosities refer to the box volume unless `volume` is given (a region cut by a mould).
 local M = {}
 
@@ -185,6 +188,12 @@ function M.expand(world, o)
     M.floor_masses(world, ids, o.mass_floor, final)
   end
   local alone = before == 0   -- the world holds only these particles: scale_radii does it at once
+  local automatic_skin = world:settings().skin == 0
+  if automatic_skin then
+    local sum = 0
+    for i = 1, #final do sum = sum + final[i] end
+    world:set_skin(0.4 * sum / #final)
+  end
   local steps = 0
   local factor = (1 / s0) ^ (1 / stages)
   for stage = 1, stages do
@@ -198,6 +207,7 @@ function M.expand(world, o)
     M.refresh_dt(world)
     steps = steps + 1 + world:cycle((o.stage_steps or 250) - 1)
   end
+  if automatic_skin then world:set_skin(0) end
   -- Below jamming the particles end without contacts: no ratio (infinite), stop there too.
   local why = "steps"
   local n = world:run{steps = o.max_steps or 1000000, every = 100, progress = o.progress,

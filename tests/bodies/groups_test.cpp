@@ -224,6 +224,25 @@ TEST(Groups, RigidBodiesRebuildWhenTheyHaveClosedTheSkin) {
   approach(v, rebuilds);
 }
 
+// The automatic skin is 0.4 x the mean radius at a build; set_skin(0) returns to it. Two spheres
+// 0.3 R apart are one pair within it, none within a skin of 0.1 R.
+TEST(Groups, SkinZeroIsAutomaticAgain) {
+  const double R = 5e-4;
+  World w;
+  w.add_particle({0, 0, 0}, R);
+  w.add_particle({2.3 * R, 0, 0}, R);
+  w.cycle(1);
+  EXPECT_EQ(w.stats().pairs, 1u) << "automatic skin 0.4 R";
+  w.set_skin(0.1 * R);
+  w.cycle(1);
+  EXPECT_EQ(w.stats().pairs, 0u) << "skin 0.1 R";
+  w.set_skin(0);
+  EXPECT_EQ(w.settings().skin, 0.0);
+  w.cycle(1);
+  EXPECT_EQ(w.stats().pairs, 1u) << "automatic again";
+  EXPECT_THROW(w.set_skin(-R), Error);
+}
+
 TEST(Groups, FreeGroupFallsWithGravityAndPlatenForceIsTheContactSum) {
   WorldSettings ws;
   ws.gravity = {0, 0, -0.01};

@@ -54,7 +54,7 @@ end
 -- The cache file of the specimen, keyed by everything that shaped it.
 local function cache_file(P, s)
   local key = ("%s_%s_n%d_h%.6g_T%.6g_p%.4g_s%d_g%.6g_k%d_gs%.4g_fc%d_l%d_b%.4g_%.4g_gap%.4g"):format(
-    P.surface_file ~= "" and P.surface_file:gsub("[^%w]", "_") or P.surface, mat.genesis.grow_floaters and "v9" or "v8", s.n, s.h, P.thickness,
+    P.surface_file ~= "" and P.surface_file:gsub("[^%w]", "_") or P.surface, mat.genesis.grow_floaters and "v10" or "v8", s.n, s.h, P.thickness,
     P.porosity, P.seed, P.gap, P.pack_steps, P.genesis_stress, mat.genesis.floater_contacts,
     mat.rev.rotation_lock_bonds, mat.rev.bond_shear_ratio, mat.rev.bond_radius_factor, P.bond_gap)
     .. (P.wall_friction ~= 0 and ("_f%.3g"):format(P.wall_friction) or "")
@@ -121,6 +121,11 @@ local function build(run)
                              inside = function(x, y, z, rad)
                                local sz = surface_z(x, y)
                                return z + rad < sz - rad or z - rad > sz + rad
+                             end,
+                             -- the mould, by the vertical distance, as above
+                             interior = function(x, y, z, m)
+                               return x >= m and Lx - x >= m and y >= m and Ly - y >= m and z + T >= m
+                                  and T - z >= m and math.abs(z - surface_z(x, y)) >= m
                              end})
   if P.stop_after == "packing" then
     if P.save ~= "" then
@@ -193,7 +198,7 @@ local function build(run)
     left_out = g.floaters_removed + #lost, floaters_removed = g.floaters_removed, floaters_grown = g.floaters_grown,
     floater_share = g.floater_share, bonds = b.bonds,
     porosity_nominal = g.porosity_nominal, porosity_true = g.porosity_true, mean_radius = g.mean_radius,
-    coordination = g.coordination, genesis_stress_pa = g.stress_pa, genesis_stress_target_pa = P.genesis_stress,
+    coordination = g.coordination, interior = g.interior, genesis_stress_pa = g.stress_pa, genesis_stress_target_pa = P.genesis_stress,
     genesis_stress_reached = g.stress_reached, radius_factor = g.radius_factor, genesis_steps = g.steps,
     genesis_seconds = g.seconds, relax_steps = b.relax_steps, relax_reached = b.relax_reached,
     bonds_broken_in_relaxation = b.broken_in_relaxation, bond_stress = b.bond_stress,
