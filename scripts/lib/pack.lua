@@ -19,9 +19,9 @@
 -- in the region (the box min..max, cut by `inside(x, y, z, r)` if given, e.g. the side of a mould),
 -- not overlapping one another at the initial radii (the final ones times initial_scale, 1/10);
 -- then the radii grow in `stages` (40) equal factors, cycling `stage_steps` (250) steps after each
--- (small steps: a light particle squeezed by a large growth step is shot away), with the Verlet
--- skin the final radii would get (an automatic skin follows the growing radii, and at a tenth of
--- them a step's travel exceeds it: a neighbour build every 3-4 steps, against every 9 with this
+-- (small steps: a light particle squeezed by a large growth step is shot away), with a Verlet
+-- skin of 0.8 final mean radii (an automatic skin follows the growing radii, and at a tenth of
+-- them a step's travel exceeds it: a neighbour build every 3-4 steps, against every 17 with this
 -- one; the world's own skin, if set, is kept); then the assembly cycles until the
 -- unbalanced-force ratio (mean unbalanced / mean contact force, PFC's) is below `ratio` (1e-4).
 -- The region must be closed by walls the caller made. Returns {first, last, steps, ratio, seconds,
@@ -192,7 +192,7 @@ function M.expand(world, o)
   if automatic_skin then
     local sum = 0
     for i = 1, #final do sum = sum + final[i] end
-    world:set_skin(0.4 * sum / #final)
+    world:set_skin(0.8 * sum / #final)
   end
   local steps = 0
   local factor = (1 / s0) ^ (1 / stages)
