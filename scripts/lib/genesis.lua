@@ -107,17 +107,31 @@ end
 -- overshooting below and creeping back up (perf/README.md: 1.4-5.8x fewer steps on 5 cm joints,
 -- the same floater share and coordination on average over seeds). Done when every set
 -- is within `tolerance` of the target at `settled` updates running and the unbalanced-force
--- ratio is below `ratio`, or, where the assembly creeps without settling that far, at `patience`
--- updates running within the tolerance (the ratio reached is reported: the bonds are installed in
--- that state, and the wall removal cycles it to equilibrium). Near jamming the creep hardly moves
--- the ratio (0.054 after 25 updates within the tolerance, 0.042 after 250, on a 2 cm joint) nor
--- the most loaded bond after the wall removal (0.31 st, 0.29 st), so the patience is short.
+-- ratio is below `ratio`, or, where the assembly creeps without settling that far, once its
+-- rattlers (particles with fewer than 3 contacts with particles) stop falling: their share,
+-- taken every `patience` updates within the tolerance, fell by less than `rattler_drop` (half a
+-- percentage point). Near jamming the creep hardly moves the ratio (0.031 -> 0.025 over 200
+-- updates on a 10 cm joint) while the packing still gathers its rattlers (36 % -> 14 % of the
+-- particles there; the ratio reached is reported: the bonds are installed in that state, and the
+-- wall removal cycles it to equilibrium).
 function M.install_stress(world, o)
   local sets, tags, volumes, target = o.sets, o.tags, o.volumes, o.target
   local tol, ratio = o.tolerance or 0.1, o.ratio or 1e-4
   local every, gain, max_change = o.every or 200, o.gain or 1, o.max_change or 2e-3
   local shrink_gain = o.shrink_gain or 1
   local settled_needed, patience = o.settled or 5, o.patience or 25
+  local rattler_drop = o.rattler_drop or 0.005
+  local function rattler_share()
+    local counts, n, r = M.contact_counts(world), 0, 0
+    for _, ids in ipairs(sets) do
+      for _, id in ipairs(ids) do
+        n = n + 1
+        if (counts[id] or 0) < 3 then r = r + 1 end
+      end
+    end
+    return r / math.max(1, n)
+  end
+  local share, last_share
   local f, p, stiff = {}, {}, {}
   for k = 1, #sets do f[k] = 1 end
   local steps, updates, settled = 0, 0, 0
@@ -159,10 +173,17 @@ function M.install_stress(world, o)
       o.log("  stress installation, %d steps: %s; ratio %.2g, dt %.3g s", steps, table.concat(t, ", "),
             world:unbalanced_force_ratio(), world:dt())
     end
-    if (settled >= settled_needed and world:unbalanced_force_ratio() <= ratio) or settled >= patience then break end
+    if settled >= settled_needed then
+      if world:unbalanced_force_ratio() <= ratio then break end
+      if (settled - settled_needed) % patience == 0 then
+        last_share, share = share, rattler_share()
+        if o.log then o.log("  stress installation, %d steps: rattlers %.1f %%", steps, 100 * share) end
+        if last_share and last_share - share < rattler_drop then break end
+      end
+    end
   end
   return {steps = steps, updates = updates, factors = f, stresses = p, reached = good(),
-          ratio = world:unbalanced_force_ratio()}
+          ratio = world:unbalanced_force_ratio(), rattlers = share or rattler_share()}
 end
 
 -- The spheres (centre c, radius r) that touch four constraints, each a sphere {x, y, z, R}
@@ -326,6 +347,7 @@ function M.pack(world, o)
             min_contacts = true, floater_tag = true, progress = true, stages = true, stage_steps = true,
             max_steps = true, log = true, wall_contacts = true, split = true, sets_count = true,
             compaction_ratio = true, compaction_steps = true, patience = true, stress_ratio = true,
+            rattler_drop = true,
             grow_floaters = true, shrink_gain = true, mass_floor = true, mean_radius = true,
             interior = true}, "genesis.pack")
   assert(o.min and o.max and o.radii and o.box, "genesis.pack: min, max, radii and box are required")
@@ -368,12 +390,13 @@ function M.pack(world, o)
   -- the 1 cm REV).
   local s = M.install_stress(world, {sets = sets, tags = tags, volumes = volumes, target = o.stress,
                                      tolerance = o.tolerance, ratio = o.stress_ratio or mat.genesis.ratio, max_steps = o.max_steps, patience = o.patience,
+                                     rattler_drop = o.rattler_drop,
                                      shrink_gain = o.shrink_gain or mat.genesis.shrink_gain,
                                      log = o.progress and log or nil})
   local fs, ps = {}, {}
   for k = 1, nsets do fs[k], ps[k] = ("%.5f"):format(s.factors[k]), ("%.4g"):format(s.stresses[k]) end
-  log("stress installed: radii x %s, mean stress %s Pa (target %.4g) in %d steps (%d neighbour builds so far), unbalanced-force ratio %.2g%s",
-      table.concat(fs, " / "), table.concat(ps, " / "), o.stress, s.steps, world:stats().rebuilds, s.ratio,
+  log("stress installed: radii x %s, mean stress %s Pa (target %.4g) in %d steps (%d neighbour builds so far), unbalanced-force ratio %.2g, rattlers %.1f %%%s",
+      table.concat(fs, " / "), table.concat(ps, " / "), o.stress, s.steps, world:stats().rebuilds, s.ratio, 100 * s.rattlers,
       s.reached and "" or " (NOT reached)")
   -- The true masses back (pack.expand's mass floor): the state is an equilibrium, which they do
   -- not enter.
@@ -453,6 +476,7 @@ function M.pack(world, o)
     floaters_grown = #grown, floater_share = (#floaters + #grown) / math.max(1, last - first + 1),
     first = first, last = last,
     compaction_steps = expanded.steps, stress_steps = s.steps, steps = expanded.steps + s.steps,
+    rattlers = s.rattlers,
     radius_factor = s.factors[1], radius_factors = s.factors, stress_pa = s.stresses[1], stresses_pa = s.stresses,
     stress_target_pa = o.stress, stress_reached = s.reached, stress_ratio = s.ratio,
     wall_stress_pa = pack.box_wall_stresses(world, o.box, o.min, o.max),
