@@ -47,7 +47,7 @@ M.rock = {young_modulus = 30853e6, poisson_ratio = 0.187, compressive_strength =
 -- 6.6 MPa on average; the figures of each packing scatter by the standard deviations of
 -- `calibration`. The joint's fracture model does not hold on this material yet (scripts/README.md).
 M.rev = {
-  young_modulus = 107.32,         -- Pa, E_REV (model units), mean over the packings
+  young_modulus = 107.71,         -- Pa, E_REV (model units), mean over the packings
   bond_tensile_strength = 0.027859, -- Pa, st of the elliptic criterion
   bond_shear_ratio = 0.3,         -- kbs / kbn of the parallel bonds
   bond_radius_factor = 1,         -- lambda [3-26]
@@ -62,11 +62,11 @@ M.rev = {
   -- Its shear strength grows by mu_b Fn under compression Fn (0: model.md 5's contact bond).
   contact_bond_friction = 0,
   calibration = {seeds = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10},
-                 young_modulus_pa = {mean = 107.32, sd = 3.033},
-                 poisson_ratio = {mean = 0.18101, sd = 0.00657},
-                 tensile_strength_mpa = {mean = 6.6168, sd = 0.2684},
-                 compressive_strength_mpa = {mean = 75.237, sd = 1.655},
-                 strength_ratio = {mean = 11.388, sd = 0.537}},
+                 young_modulus_pa = {mean = 107.71, sd = 2.981},
+                 poisson_ratio = {mean = 0.18123, sd = 0.00609},
+                 tensile_strength_mpa = {mean = 6.6046, sd = 0.2304},
+                 compressive_strength_mpa = {mean = 75.109, sd = 2.240},
+                 strength_ratio = {mean = 11.386, sd = 0.548}},
 }
 
 -- A contact-bond strength factor as a script gives it -> the number the engine takes: `word`
