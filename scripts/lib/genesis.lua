@@ -29,8 +29,8 @@
 --   4. the particles' friction restored (world:set_friction); the walls stay frictionless.
 --      The state (floater share, porosity, coordination) is reported over the specimen and over
 --      its interior: the particles whose centres lie 3 mean radii or more from its walls (the
---      box, or `interior(x, y, z, margin)` if given), where the walls' layering does not reach, so that
---      specimens of different sizes and shapes compare as materials.
+--      box, or `interior(x, y, z, margin)` if given), where the walls' layering does not reach,
+--      so that specimens of different sizes and shapes compare as materials.
 -- bond:
 --   5. bonds installed in each id set on its own (model.md 5: contacts keep their forces, beams
 --      start at zero), the walls removed, the assembly cycled to equilibrium.

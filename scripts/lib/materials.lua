@@ -19,15 +19,16 @@ M.packing = {mean_radius = 0.5e-3, radius_sd = 0.1e-3, cut = 3, porosity = 0.51}
 -- Genesis [scenarios.md 1; lib/genesis.lua]: the particle count from the thesis's porosity
 -- definition [3-35] at `porosity` (denser than the thesis's 0.51: a frictionless assembly jams
 -- near 0.45 in a 1 cm box), compacted without friction, the isotropic `stress` installed by a
--- common radius factor until the unbalanced-force ratio is `ratio`; particles with fewer than
--- `floater_contacts` contacts (floaters) are given the radius and place at which they touch four
--- neighbours (`grow_floaters`; those that find none are taken out). The stress is about 0.35 % of the REV's compressive
--- strength; the bonds then need at most a third of st after the wall removal (the largest bond
+-- common radius factor until the unbalanced-force ratio is `ratio` (or, where the packing creeps,
+-- until its rattlers stop falling); particles with fewer than `floater_contacts` contacts
+-- (floaters) are given the radius and place at which they touch four neighbours
+-- (`grow_floaters`; those that find none are taken out). The stress is about 0.3 % of the REV's
+-- compressive strength; the bonds then need at most a third of st after the wall removal (the largest bond
 -- stress is about 8 times the mean stress, the tail of the contact forces). While packing, the
 -- particles smaller than `mass_floor` x mean radius weigh as one of that radius: the lightest set
 -- the critical time step [3-30], and the packed state is an equilibrium, which masses do not enter
--- (2.5x the time step; the same floater share at 1, 2 and 5 cm, where true masses left 13-20 %;
--- 10 cm 20 % against 27). The stress servo shrinks the radii at a quarter of its gain
+-- (2.5x the time step; the same floater share at 1, 2 and 5 cm, where true masses left
+-- 13-20 %). The stress servo shrinks the radii at a quarter of its gain
 -- (`shrink_gain`), coming down to the stress with the relaxation: 1.4-5.8x fewer steps on 5 cm
 -- joints, the same state on average over seeds (perf/README.md).
 M.genesis = {porosity = 0.45, stress = 8e-4, floater_contacts = 3, ratio = 1e-2, grow_floaters = true,
