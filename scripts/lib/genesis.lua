@@ -28,9 +28,10 @@
 --      by `wall_contacts(x, y, z, r)` (default: the faces of the box min..max).
 --   4. the particles' friction restored (world:set_friction); the walls stay frictionless.
 --      The state (floater share, porosity, coordination) is reported over the specimen and over
---      its interior: the particles whose centres lie 3 mean radii or more from its walls (the
---      box, or `interior(x, y, z, margin)` if given), where the walls' layering does not reach,
---      so that specimens of different sizes and shapes compare as materials.
+--      its interior: the particles whose centres lie 3 mean radii or more from the box's faces
+--      and pass `interior(x, y, z, margin)` if given (other walls, such as a mould), where the
+--      walls' layering does not reach, so that specimens of different sizes and shapes compare
+--      as materials.
 -- bond:
 --   5. bonds installed in each id set on its own (model.md 5: contacts keep their forces, beams
 --      start at zero), the walls removed, the assembly cycled to equilibrium.
@@ -108,25 +109,25 @@ end
 -- the same floater share and coordination on average over seeds). Done when every set
 -- is within `tolerance` of the target at `settled` updates running and the unbalanced-force
 -- ratio is below `ratio`, or, where the assembly creeps without settling that far, once its
--- rattlers (particles with fewer than 3 contacts with particles) stop falling: their share,
--- taken every `patience` updates within the tolerance, fell by less than `rattler_drop` (half a
--- percentage point). Near jamming the creep hardly moves the ratio (0.031 -> 0.025 over 200
--- updates on a 10 cm joint) while the packing still gathers its rattlers (36 % -> 14 % of the
--- particles there; the ratio reached is reported: the bonds are installed in that state, and the
--- wall removal cycles it to equilibrium).
+-- rattlers (particles with fewer than `min_contacts`, 3, contacts with particles) stop falling:
+-- their share, taken every `patience` updates within the tolerance, fell by less than
+-- `rattler_drop` (half a percentage point). Near jamming the creep hardly moves the ratio
+-- (0.031 -> 0.025 over 200 updates on a 10 cm joint) while the packing still gathers its
+-- rattlers (36 % -> 14 % of the particles there; the ratio reached is reported: the bonds are
+-- installed in that state, and the wall removal cycles it to equilibrium).
 function M.install_stress(world, o)
   local sets, tags, volumes, target = o.sets, o.tags, o.volumes, o.target
   local tol, ratio = o.tolerance or 0.1, o.ratio or 1e-4
   local every, gain, max_change = o.every or 200, o.gain or 1, o.max_change or 2e-3
   local shrink_gain = o.shrink_gain or 1
   local settled_needed, patience = o.settled or 5, o.patience or 25
-  local rattler_drop = o.rattler_drop or 0.005
+  local rattler_drop, min_contacts = o.rattler_drop or 0.005, o.min_contacts or 3
   local function rattler_share()
     local counts, n, r = M.contact_counts(world), 0, 0
     for _, ids in ipairs(sets) do
       for _, id in ipairs(ids) do
         n = n + 1
-        if (counts[id] or 0) < 3 then r = r + 1 end
+        if (counts[id] or 0) < min_contacts then r = r + 1 end
       end
     end
     return r / math.max(1, n)
@@ -390,7 +391,7 @@ function M.pack(world, o)
   -- the 1 cm REV).
   local s = M.install_stress(world, {sets = sets, tags = tags, volumes = volumes, target = o.stress,
                                      tolerance = o.tolerance, ratio = o.stress_ratio or mat.genesis.ratio, max_steps = o.max_steps, patience = o.patience,
-                                     rattler_drop = o.rattler_drop,
+                                     rattler_drop = o.rattler_drop, min_contacts = o.min_contacts,
                                      shrink_gain = o.shrink_gain or mat.genesis.shrink_gain,
                                      log = o.progress and log or nil})
   local fs, ps = {}, {}
@@ -453,9 +454,9 @@ function M.pack(world, o)
   for _, id in ipairs(kept) do contacts = contacts + (counts[id] or 0) end
   -- The same figures away from the walls (the material, not its boundary layers).
   local margin = 3 * (o.mean_radius or mat.packing.mean_radius)
-  local interior = o.interior or function(x, y, z, m)
+  local function interior(x, y, z, m)
     return x - lo[1] >= m and hi[1] - x >= m and y - lo[2] >= m and hi[2] - y >= m
-       and z - lo[3] >= m and hi[3] - z >= m
+       and z - lo[3] >= m and hi[3] - z >= m and (not o.interior or o.interior(x, y, z, m))
   end
   local taken_out, placed = {}, {}
   for _, id in ipairs(floaters) do taken_out[id] = true end

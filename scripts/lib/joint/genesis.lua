@@ -122,11 +122,8 @@ local function build(run)
                                local sz = surface_z(x, y)
                                return z + rad < sz - rad or z - rad > sz + rad
                              end,
-                             -- the mould, by the vertical distance, as above
-                             interior = function(x, y, z, m)
-                               return x >= m and Lx - x >= m and y >= m and Ly - y >= m and z + T >= m
-                                  and T - z >= m and math.abs(z - surface_z(x, y)) >= m
-                             end})
+                             -- away from the mould too, by the vertical distance, as above
+                             interior = function(x, y, z, m) return math.abs(z - surface_z(x, y)) >= m end})
   if P.stop_after == "packing" then
     if P.save ~= "" then
       w:save(P.save)
