@@ -12,6 +12,8 @@ M.citation = "A. Varela Valdez, Mechanical behavior of rock joints: influence of
              "its closure and shear behavior, PhD thesis, Universite de Bordeaux and Universidad " ..
              "Autonoma de Nuevo Leon, 2015"
 M.normal_stress_mpa = 14
+-- The surfaces the tables give, in their order.
+M.surfaces = {"S1", "S4", "S5", "S8"}
 
 local T = {   -- surface = {rigid, elastic, fracture} x {peak, residual, k0}
   S1 = {rigid = {16.15, 10.24, 56.9}, elastic = {18.05, 12.48, 82.8}, fracture = {17.92, 11.68, 78.8}},

@@ -12,19 +12,11 @@ local ev = require("events")
 
 local M = {}
 
--- The reference study's joints at 14 MPa (reference.md 2, thesis Tables 4-1/4-2): peak and residual
--- shear stress (MPa) and initial shear stiffness K0 (MPa/mm) per model.
-M.REFERENCE_STRESS = 14
-M.REFERENCE = {
-  S1 = {peak = {rigid = 16.15, elastic = 18.05, fracture = 17.92}, residual = {rigid = 10.24, elastic = 12.48, fracture = 11.68},
-        k0 = {rigid = 56.9, elastic = 82.8, fracture = 78.8}},
-  S4 = {peak = {rigid = 12.32, elastic = 13.06, fracture = 13.07}, residual = {rigid = 9.07, elastic = 11.30, fracture = 10.82},
-        k0 = {rigid = 53.2, elastic = 105.3, fracture = 96.1}},
-  S5 = {peak = {rigid = 20.51, elastic = 22.34, fracture = 22.05}, residual = {rigid = 9.00, elastic = 12.63, fracture = 10.82},
-        k0 = {rigid = 64.1, elastic = 82.9, fracture = 76.0}},
-  S8 = {peak = {rigid = 15.34, elastic = 16.53, fracture = 16.36}, residual = {rigid = 8.74, elastic = 10.54, fracture = 10.59},
-        k0 = {rigid = 62.5, elastic = 88.6, fracture = 89.2}},
-}
+-- The reference study's joints (reference.md 2, thesis Tables 4-1/4-2; lib/reference.lua): peak
+-- and residual shear stress (MPa) and initial shear stiffness K0 (MPa/mm) per surface and model.
+local reference = require("reference")
+M.REFERENCE_STRESS = reference.normal_stress_mpa
+local function thesis(surface, model) return reference.joint(surface, model, M.REFERENCE_STRESS) end
 -- Surface statistics (surfaces.md 4) for the reference's points on the H, Lc, s2 axes.
 local SURFACE = {S1 = {0.75, 16, 0.547}, S2 = {0.75, 16, 0.328}, S3 = {0.75, 20, 0.547}, S4 = {0.75, 20, 0.328},
                  S5 = {0.52, 16, 0.547}, S6 = {0.52, 16, 0.328}, S7 = {0.52, 20, 0.547}, S8 = {0.52, 20, 0.328}}
@@ -391,6 +383,112 @@ local function trends_markdown(T, rows)
   return table.concat(lines, "\n") .. "\n"
 end
 
+-- Against the reference (reference.md 2): per surface of the thesis's tables and model, the mean
+-- over the directions and seeds of the runs at its normal stress, beside the thesis's values.
+local function reference_markdown(rows)
+  local stress = M.REFERENCE_STRESS
+  local sides, by = {}, {}
+  for _, r in ipairs(rows) do
+    if r.status == "finished" and math.abs(r.stress_mpa - stress) < 1e-9 then
+      local k = r.surface .. " " .. r.model
+      by[k] = by[k] or {}
+      table.insert(by[k], r)
+      if finite(r.size) then sides[("%g"):format(r.size * 100)] = true end
+    end
+  end
+  local lines = {"", ("## Against the reference (reference.md 2, %g MPa)"):format(stress), ""}
+  local side_list = {}
+  for k in pairs(sides) do side_list[#side_list + 1] = k end
+  table.sort(side_list)
+  lines[#lines + 1] = ("The thesis's values (Tables 4-1 / 4-2: 10 cm joints, the mean of x and y) beside this study's, " ..
+                       "the mean over the directions and seeds of its runs (joints of %s cm). Relative differences " ..
+                       "from the thesis's value; peak / sigma_n is the ratio that transfers between specimens " ..
+                       "(reference.md 2)%s."):format(#side_list > 0 and table.concat(side_list, ", ") or "unknown side",
+                       (#side_list > 0 and tonumber(side_list[1]) < 10) and
+                       "; scenarios.md 3 gives the offset of a 5 cm joint from a 10 cm one" or "")
+  lines[#lines + 1] = ""
+  lines[#lines + 1] = "| surface | model | runs | peak MPa: ours / thesis | residual MPa | K0 MPa/mm | peak / sigma_n |"
+  lines[#lines + 1] = "|---|---|---|---|---|---|---|"
+  local diffs = {}
+  local function cell(ours, ref, field, model)
+    local f = field == "k0" and "%.1f" or "%.2f"
+    if not finite(ours) then return ("n/a / " .. f):format(ref) end
+    local d = (ours - ref) / ref
+    diffs[model] = diffs[model] or {}
+    diffs[model][field] = diffs[model][field] or {}
+    table.insert(diffs[model][field], d)
+    return (f .. " / " .. f .. " (%+.0f %%)"):format(ours, ref, 100 * d)
+  end
+  local any = false
+  for _, surface in ipairs(reference.surfaces) do
+    for _, model in ipairs(MODELS) do
+      local ref = thesis(surface, model)
+      local runs = by[surface .. " " .. model] or {}
+      local function avg(f)
+        local v = {}
+        for _, r in ipairs(runs) do if finite(r[f]) then v[#v + 1] = r[f] end end
+        return #v > 0 and (mean_sd(v)) or nil
+      end
+      if #runs > 0 then
+        any = true
+        local peak = avg("peak_shear_stress_mpa")
+        lines[#lines + 1] = ("| %s | %s | %d | %s | %s | %s | %.3f / %.3f |"):format(surface, model, #runs,
+          cell(peak, ref.peak, "peak", model), cell(avg("residual_shear_stress_mpa"), ref.residual, "residual", model),
+          cell(avg("initial_shear_stiffness_mpa_per_mm"), ref.k0, "k0", model),
+          finite(peak) and peak / stress or 0 / 0, ref.peak / stress)
+      else
+        lines[#lines + 1] = ("| %s | %s | 0 | not run / %.2f | not run / %.2f | not run / %.1f | |"):format(surface, model,
+          ref.peak, ref.residual, ref.k0)
+      end
+    end
+  end
+  if not any then
+    lines[#lines + 1] = ""
+    lines[#lines + 1] = ("No run of S1, S4, S5 or S8 at %g MPa: nothing to compare."):format(stress)
+    return table.concat(lines, "\n") .. "\n"
+  end
+  lines[#lines + 1] = ""
+  for _, model in ipairs(MODELS) do
+    local d = diffs[model]
+    if d then
+      local parts = {}
+      for _, f in ipairs{{"peak", "peak"}, {"residual", "residual"}, {"k0", "K0"}} do
+        if d[f[1]] then
+          parts[#parts + 1] = ("%s %+.1f %%"):format(f[2], 100 * (mean_sd(d[f[1]])))
+        end
+      end
+      lines[#lines + 1] = ("- %s, mean difference over the surfaces run: %s"):format(model, table.concat(parts, ", "))
+    end
+  end
+  return table.concat(lines, "\n") .. "\n"
+end
+
+-- The figures inline (Markdown images, paths relative to the study folder), so that trends.md
+-- reads as one page on a code host.
+local SECTIONS = {{"strength", "Peak and residual against the surface statistics"},
+                  {"stiffness", "Initial shear stiffness"}, {"energy", "Energy at the end of the shear"},
+                  {"models", "The three models, per surface and normal stress"},
+                  {"curves", "S1 to S8, per model, normal stress and direction"},
+                  {"events", "Event statistics of the fracture runs (events/)"}}
+local function figures_markdown(figures)
+  if #figures == 0 then return "" end
+  local lines = {"", "## Figures"}
+  for _, sec in ipairs(SECTIONS) do
+    local here = {}
+    for _, f in ipairs(figures) do if f.section == sec[1] then here[#here + 1] = f end end
+    table.sort(here, function(a, b) return a.file < b.file end)
+    if #here > 0 then
+      lines[#lines + 1] = ""
+      lines[#lines + 1] = "### " .. sec[2]
+      lines[#lines + 1] = ""
+      for _, f in ipairs(here) do
+        lines[#lines + 1] = ("![%s](%s)"):format((f.title or f.file):gsub("[%[%]]", ""), f.file)
+      end
+    end
+  end
+  return table.concat(lines, "\n") .. "\n"
+end
+
 -- Mean and scatter over seeds --------------------------------------------------------------------
 local CASE_FIELDS = {"peak_shear_stress_mpa", "peak_displacement_mm", "residual_shear_stress_mpa",
                      "initial_shear_stiffness_mpa_per_mm", "max_dilatancy_mm", "normal_stiffness_mpa_per_mm",
@@ -433,17 +531,24 @@ local function plots(dir, rows, curves, log)
   asperity.mkdir(pdir)
   local done = {}
   for _, r in ipairs(rows) do if r.status == "finished" and curves[r.name] then done[#done + 1] = r end end
-  if #done == 0 then return 0 end
+  if #done == 0 then return 0, {} end
   local first_seed = math.huge
   for _, r in ipairs(done) do first_seed = math.min(first_seed, r.seed) end
-  local count = 0
-  local function draw(o) if fig.curves(o) then count = count + 1 end end
+  local count, figures = 0, {}
+  local section
+  local function draw(o)
+    if fig.curves(o) then
+      count = count + 1
+      figures[#figures + 1] = {file = "plots/" .. o.file:match("([^/]+)$"), title = o.title, section = section}
+    end
+  end
   local function sel(pred)
     local t = {}
     for _, r in ipairs(done) do if r.seed == first_seed and pred(r) then t[#t + 1] = r end end
     return t
   end
   -- Curves of S1..S8 per model, stress and direction (the first seed).
+  section = "curves"
   local cases = {}
   for _, r in ipairs(done) do
     local k = ("%s_%g_%s"):format(r.model, r.stress_mpa, r.direction)
@@ -466,6 +571,7 @@ local function plots(dir, rows, curves, log)
     end
   end
   -- Per surface and stress: the three models (colour) in both directions (x solid, y dashed).
+  section = "models"
   local per = {}
   for _, r in ipairs(done) do per[("%s_%g"):format(r.surface, r.stress_mpa)] = {r.surface, r.stress_mpa} end
   for name, sc in pairs(per) do
@@ -484,6 +590,7 @@ local function plots(dir, rows, curves, log)
     end
   end
   -- Peak (filled) and residual (open) against H, Lc, s2, per stress; the reference's at 14 MPa in black.
+  section = "strength"
   local stresses = {}
   for _, r in ipairs(done) do stresses[r.stress_mpa] = true end
   for stress in pairs(stresses) do
@@ -504,8 +611,8 @@ local function plots(dir, rows, curves, log)
       local scale = stress / M.REFERENCE_STRESS
       for _, which in ipairs{{"peak", 5}, {"residual", 4}} do
         local xs, ys = {}, {}
-        for s, ref in pairs(M.REFERENCE) do
-          for _, m in ipairs(MODELS) do xs[#xs + 1] = SURFACE[s][axis]; ys[#ys + 1] = ref[which[1]][m] * scale end
+        for _, s in ipairs(reference.surfaces) do
+          for _, m in ipairs(MODELS) do xs[#xs + 1] = SURFACE[s][axis]; ys[#ys + 1] = thesis(s, m)[which[1]] * scale end
         end
         series[#series + 1] = {title = ("thesis %s (all models)%s"):format(which[1],
                                  scale == 1 and "" or (", x %g/%g"):format(stress, M.REFERENCE_STRESS)),
@@ -518,6 +625,7 @@ local function plots(dir, rows, curves, log)
     end
   end
   -- Initial shear stiffness against the normal stress.
+  section = "stiffness"
   do
     local series = {}
     for _, m in ipairs(MODELS) do
@@ -527,7 +635,7 @@ local function plots(dir, rows, curves, log)
       end
       series[#series + 1] = {title = m, x = xs, y = ys, style = "points", color = COLOR[m], size = 1.5}
       local rx, ry = {}, {}
-      for _, ref in pairs(M.REFERENCE) do rx[#rx + 1] = M.REFERENCE_STRESS; ry[#ry + 1] = ref.k0[m] end
+      for _, s in ipairs(reference.surfaces) do rx[#rx + 1] = M.REFERENCE_STRESS; ry[#ry + 1] = thesis(s, m).k0 end
       series[#series + 1] = {title = "thesis " .. m, x = rx, y = ry, style = "points", point = 4, color = COLOR[m], size = 2}
     end
     local lo, hi = M.REFERENCE_STRESS, M.REFERENCE_STRESS
@@ -537,6 +645,7 @@ local function plots(dir, rows, curves, log)
          series = series, xrange = ("%g:%g"):format(lo - 0.1 * (hi - lo) - 1, hi + 0.1 * (hi - lo) + 1)}
   end
   -- Energy shares at the end of the shear per surface (mean over the runs of a surface), per model.
+  section = "energy"
   for _, m in ipairs(MODELS) do
     local series = {}
     for _, term in ipairs{"friction", "damping", "strain", "kinetic", "released"} do
@@ -554,7 +663,7 @@ local function plots(dir, rows, curves, log)
          title = m .. ": energy terms at the end of the shear (thesis: friction ~0.8)", series = series,
          extra = "set xtics 1\n"}
   end
-  return count
+  return count, figures
 end
 
 -- Event statistics -------------------------------------------------------------------------------
@@ -705,9 +814,19 @@ function M.write(o)
   write_atomic(dir .. "/study_cases.csv", cases_csv)
   local T = M.trends(rows, curves)
   write_atomic(dir .. "/trends.json", asperity.json({trends = T}))
-  write_atomic(dir .. "/trends.md", trends_markdown(T, rows))
-  local n = plots(dir, rows, curves, log)
+  local n, figures = plots(dir, rows, curves, log)
   local e = events(dir, rows, log)
+  for _, name in ipairs{"sizes", "xcorr", "fluctuations"} do   -- the pooled event figures, where drawn
+    local f = io.open(("%s/events/%s.png"):format(dir, name))
+    if f then
+      f:close()
+      figures[#figures + 1] = {file = ("events/%s.png"):format(name), section = "events",
+                               title = ({sizes = "event sizes, pooled over the fracture runs",
+                                         xcorr = "cross-correlation of the energies with the break count",
+                                         fluctuations = "fluctuations of the energies"})[name]}
+    end
+  end
+  write_atomic(dir .. "/trends.md", trends_markdown(T, rows) .. reference_markdown(rows) .. figures_markdown(figures))
   local shown = 0
   for _, t in ipairs(T) do if t.verdict == "shown" then shown = shown + 1 end end
   log("report: trends.md (%d of %d behaviours shown), %d plots in plots/, events of %d fracture runs%s",

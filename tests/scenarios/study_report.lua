@@ -19,7 +19,7 @@ for _, seed in ipairs{1, 2} do
         local peak = base[model] * (surface == "S5" and 1.5 or 1) * stress / 14 * (seed == 2 and 1.1 or 1)
         rows[#rows + 1] = {
           name = ("%s_%g_x_%s_s%d"):format(surface, stress, model, seed), status = "finished", surface = surface,
-          H = H[surface], Lc_mm = 16, s2_mm2 = 0.547, stress_mpa = stress, direction = "x", model = model, seed = seed,
+          H = H[surface], Lc_mm = 16, s2_mm2 = 0.547, stress_mpa = stress, size = 0.05, direction = "x", model = model, seed = seed,
           peak_shear_stress_mpa = peak, residual_shear_stress_mpa = 0.6 * stress * (seed == 2 and 1.1 or 1),
           initial_shear_stiffness_mpa_per_mm = 50 * stress / 14 + (model == "rigid" and 0 or 30),
           max_dilatancy_mm = ({rigid = 1.0, elastic = 0.9, fracture = 0.5})[model] * (surface == "S5" and 1.4 or 1) * 14 / stress,
@@ -155,6 +155,27 @@ local md = io.open(out .. "/trends.md"):read("a")
 assert(md:find("| peak shear stress grows as H falls | shown | 12 / 12 | mean relative change -33.3 %", 1, true), md)
 assert(md:find("12 cases ran with two or more seeds", 1, true), "the scatter over seeds is reported:\n" .. md)
 assert(md:find("- peak_shear_stress_mpa: 6.7 %", 1, true), "SD / mean of p and 1.1 p is 6.7 %:\n" .. md)
+-- Against the reference: S1 rigid at 14 MPa ran with seeds 1 and 2 (peaks 10 and 11), the thesis's 16.15;
+-- S4 did not run.
+assert(md:find("## Against the reference (reference.md 2, 14 MPa)", 1, true), md)
+assert(md:find("joints of 5 cm", 1, true), md)
+assert(md:find("| S1 | rigid | 2 | 10.50 / 16.15 (-35 %) |", 1, true), md)
+assert(md:find("| S4 | elastic | 0 | not run / 13.06 |", 1, true), md)
+assert(md:find("- rigid, mean difference over the surfaces run: peak ", 1, true), md)
+-- The figures inline, by section, with paths relative to the study folder.
+assert(md:find("### Peak and residual against the surface statistics", 1, true), md)
+assert(md:find("](plots/strength_vs_H_14.png)", 1, true), md)
+assert(md:find("](plots/shear_fracture_21_x.png)", 1, true), md)
+local images = 0
+for path in md:gmatch("!%[[^%]]*%]%(([^)]+)%)") do
+  images = images + 1
+  local f = io.open(out .. "/" .. path)
+  assert(f, "trends.md shows a figure that is not there: " .. path)
+  f:close()
+end
+local pngs = 0
+for _ in io.popen("ls '" .. out .. "/plots'"):lines() do pngs = pngs + 1 end
+assert(images >= pngs, ("trends.md shows %d figures, plots/ holds %d"):format(images, pngs))
 local tj = json.read(out .. "/trends.json")
 assert(#tj.trends == 21, ("trends.json: %d behaviours"):format(#tj.trends))
 for _, png in ipairs{"shear_fracture_21_x", "models_S5_14", "strength_vs_H_14", "strength_vs_H_21", "shear_stiffness_vs_stress",
