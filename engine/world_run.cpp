@@ -136,6 +136,11 @@ void World::set_friction(double mu) {
   // Only the slip limit [3-22] changes: a shear force above mu Fn slips at the next step.
   state_->settings.contact = m;
 }
+void World::set_damping(double alpha) {
+  check_setting("set_damping", "damping", alpha);
+  // Read by the integration at every step: nothing cached depends on it.
+  state_->settings.local_damping = alpha;
+}
 void World::set_rotation_lock_bonds(double k) {
   check_setting("set_rotation_lock_bonds", "rotation_lock_bonds", k);
   require(k == std::floor(k), "set_rotation_lock_bonds: rotation_lock_bonds must be a whole number, got " + num(k));

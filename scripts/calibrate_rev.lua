@@ -38,6 +38,7 @@ local P = params_lib.parse{
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "passed to rev.lua"},
   {"genesis_shrink_gain", mat.genesis.shrink_gain, above = 0, max = 1, doc = "passed to rev.lua"},
   {"genesis_mass_floor", mat.genesis.mass_floor, min = 0, max = 2, doc = "passed to rev.lua"},
+  {"genesis_damping", mat.genesis.damping, min = 0, below = 1, doc = "passed to rev.lua"},
   {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "passed to rev.lua"},
   {"out", "out/calibration", nonempty = true, doc = "output folder (one folder per trial and seed)"},
   {"cache", "", doc = "packings cached here (\"\": out/cache)"},
@@ -68,7 +69,7 @@ local function rev(st, tests, seed, name)
             contact_strength = P.contact_strength, contact_shear_strength = P.contact_shear_strength,
             contact_bond_friction = P.contact_bond_friction,
             grow_floaters = P.grow_floaters,
-            genesis_stress = P.genesis_stress, genesis_shrink_gain = P.genesis_shrink_gain, genesis_mass_floor = P.genesis_mass_floor, porosity = P.porosity,
+            genesis_stress = P.genesis_stress, genesis_shrink_gain = P.genesis_shrink_gain, genesis_mass_floor = P.genesis_mass_floor, genesis_damping = P.genesis_damping, porosity = P.porosity,
             out = ("%s/%s_seed%d"):format(out, name, seed)}
   return dofile(rev_script)
 end

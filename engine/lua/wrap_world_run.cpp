@@ -278,6 +278,8 @@ std::span<const Function> world_run_methods() {
        "Deeper, one centre is inside the other particle; a rigid block's contacts may go there."},
       {"set_friction", set_world_number<&World::set_friction>, "world:set_friction(mu)",
        "Ball-ball Coulomb coefficient from the next step on (walls keep theirs)."},
+      {"set_damping", set_world_number<&World::set_damping>, "world:set_damping(alpha)",
+       "Local (Cundall) damping [3-28] from the next step on, 0 <= alpha < 1 (groups with their own keep it)."},
       {"critical_dt", world_critical_dt, "world:critical_dt() -> s",
        "Critical time step estimate now, without the safety factor."},
       {"step", world_step, "world:step() -> n", "Steps done so far."},

@@ -513,6 +513,7 @@ class World {
   // particle holding a bond does not rotate), applied at once.
   void set_rotation_lock_bonds(double k);
   void set_friction(double mu);           // ball-ball Coulomb coefficient from now on (>= 0)
+  void set_damping(double alpha);         // local damping [3-28] from the next step on, [0, 1)
   double critical_dt();                   // estimate now [3-30..3-32], without safety factor
   std::uint64_t step_count() const;
   double time() const;

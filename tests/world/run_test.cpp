@@ -140,3 +140,20 @@ TEST(Run, APlanWithoutAnEndOrWithBadValuesIsRefused) {
   EXPECT_THROW(w.run(ratio), Error);
   EXPECT_EQ(w.step_count(), 0u);
 }
+
+TEST(Run, SetDampingStepsAsAWorldMadeWithThatDamping) {
+  // [3-28] read at every step: damping changed on a world moves its particles exactly as a world
+  // made with that damping, and differently from the damping it had.
+  WorldSettings made_low, made_high;
+  made_low.local_damping = 0.2;
+  made_high.local_damping = 0.7;
+  World low = random_box(60, made_low), changed = random_box(60, made_high), high = random_box(60, made_high);
+  changed.set_damping(0.2);
+  low.cycle(300);
+  changed.cycle(300);
+  high.cycle(300);
+  EXPECT_EQ(positions(changed), positions(low));
+  EXPECT_NE(positions(changed), positions(high));
+  EXPECT_THROW(changed.set_damping(1.0), Error);
+  EXPECT_THROW(changed.set_damping(-0.1), Error);
+}
