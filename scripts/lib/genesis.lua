@@ -15,9 +15,7 @@
 --      depend on where a frictional packing happened to lock. Until the stress is installed (step
 --      2), particles below `mass_floor` (materials.lua genesis.mass_floor, 1) x `mean_radius`
 --      weigh as one of that radius: the lightest particles set the critical time step, and the
---      packed state is an equilibrium, which masses do not enter (2.5x the step). Steps 1 and 2 run
---      with the local damping `damping` (materials.lua genesis.damping, 0.3), the world's own after:
---      the slow collective relaxation of a packing near jamming is what the damping holds back.
+--      packed state is an equilibrium, which masses do not enter (2.5x the step).
 --   2. a low isotropic stress installed by scaling the radii by one factor (M.install_stress, a
 --      servo) until the mean stress of the assembly (from its contacts, world:contact_stress) is
 --      `stress`; with `split(x, y, z)` -> 1..sets_count, each set (the halves of a joint) has its
@@ -108,10 +106,8 @@ end
 -- genesis.pack's default materials.lua genesis.shrink_gain, 1/4) shrinks more gently than it
 -- grows, so that a set above the target comes down to it with the relaxation instead of
 -- overshooting below and creeping back up (perf/README.md: 1.4-5.8x fewer steps on 5 cm joints,
--- the same floater share and coordination on average over seeds); growing, its gain doubles at
--- each update below the band until the set is above the target. Done when the stress of every
--- set, averaged over the last `settled` updates, is within `tolerance` of the target at
--- `settled` updates running and the unbalanced-force
+-- the same floater share and coordination on average over seeds). Done when every set
+-- is within `tolerance` of the target at `settled` updates running and the unbalanced-force
 -- ratio is below `ratio`, or, where the assembly creeps without settling that far, once its
 -- rattlers (particles with fewer than `min_contacts`, 3, contacts with particles) stop falling:
 -- their share, taken every `patience` updates within the tolerance, fell by less than
@@ -137,26 +133,15 @@ function M.install_stress(world, o)
     return r / math.max(1, n)
   end
   local share, last_share
-  local f, p, stiff, boost = {}, {}, {}, {}
-  for k = 1, #sets do f[k], boost[k] = 1, 1 end
-  local max_boost = o.max_boost or 1024
+  local f, p, stiff = {}, {}, {}
+  for k = 1, #sets do f[k] = 1 end
   local steps, updates, settled = 0, 0, 0
   local max_steps = o.max_steps or 1000000
   local function measure()
     for k = 1, #sets do p[k], stiff[k] = world:contact_stress(tags[k], volumes[k]) end
   end
-  -- Within the tolerance: each set's stress averaged over the last `settled_needed` updates (a
-  -- packing that still moves reads a few percent either way from one update to the next).
-  local recent = {}
-  for k = 1, #sets do recent[k] = {} end
   local function good()
-    for k = 1, #sets do
-      local r = recent[k]
-      if #r < settled_needed then return false end
-      local mean = 0
-      for i = #r - settled_needed + 1, #r do mean = mean + r[i] end
-      if math.abs(mean / settled_needed - target) > tol * target then return false end
-    end
+    for k = 1, #sets do if math.abs(p[k] - target) > tol * target then return false end end
     return true
   end
   pack.refresh_dt(world)
@@ -166,22 +151,12 @@ function M.install_stress(world, o)
     for k = 1, #sets do
       local df
       if stiff[k] > 0 then
-        df = (p[k] > target and shrink_gain or boost[k]) * gain * (target - p[k]) / stiff[k]
+        df = (p[k] > target and shrink_gain or 1) * gain * (target - p[k]) / stiff[k]
       else
         df = max_change      -- no contact in the set: grow towards jamming
       end
       df = math.max(-max_change, math.min(max_change, df))
       -- a dead band of half the tolerance: the set settles, and stays centred in the tolerance
-      -- Growing, the gain doubles at each update that finds the set below the band, until it is
-      -- above the target again: near jamming the affine stiffness overstates the true one ~600x,
-      -- so at gain 1 a set whose stress hovers about the band's lower edge creeps up for tens of
-      -- thousands of steps (a 5 cm half: 50 000). Above the target the relaxation helps and the
-      -- gain stays low (shrink_gain).
-      if p[k] >= target or stiff[k] == 0 then
-        boost[k] = 1
-      elseif p[k] < (1 - 0.5 * tol) * target then
-        boost[k] = math.min(2 * boost[k], max_boost)
-      end
       if math.abs(p[k] - target) > 0.5 * tol * target or stiff[k] == 0 then
         local change = (f[k] + df) / f[k]
         for _, id in ipairs(sets[k]) do world:set_radius(id, world:radius(id) * change) end
@@ -192,11 +167,6 @@ function M.install_stress(world, o)
     steps = steps + world:cycle(every)
     updates = updates + 1
     measure()
-    for k = 1, #sets do
-      local r = recent[k]
-      r[#r + 1] = p[k]
-      if #r > settled_needed then table.remove(r, 1) end
-    end
     if good() then settled = settled + 1 else settled = 0 end
     if o.log and updates % 25 == 0 then
       local t = {}
@@ -390,10 +360,12 @@ function M.pack(world, o)
   -- nominal one) weigh as one of it (pack.expand): a longer time step for an end state that masses
   -- do not enter.
   local floor = (o.mass_floor or mat.genesis.mass_floor) * (o.mean_radius or mat.packing.mean_radius)
-  -- The local damping of the packing steps (compaction and stress installation; materials.lua
-  -- genesis.damping), the world's own back after them.
+  -- `damping`: the local damping of the packing steps (compaction and stress installation), the
+  -- world's own back after them; by default the world's throughout. (0.3 gathered a 10 cm
+  -- packing's rattlers in a third of the steps, but left one REV packing of ten with 99.9 % of its
+  -- bonds needing 0.337 st, above scenarios.md 1's third: perf/README.md.)
   local damping = world:settings().damping
-  world:set_damping(o.damping or mat.genesis.damping)
+  if o.damping then world:set_damping(o.damping) end
   -- 1. Frictionless compaction.
   world:set_friction(0)
   -- The compaction need not settle finely: the stress installation that follows does.
