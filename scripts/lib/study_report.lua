@@ -531,14 +531,12 @@ local function plots(dir, rows, curves, log)
   asperity.mkdir(pdir)
   local done = {}
   for _, r in ipairs(rows) do if r.status == "finished" and curves[r.name] then done[#done + 1] = r end end
-  if #done == 0 then return 0, {} end
+  if #done == 0 then return {} end
   local first_seed = math.huge
   for _, r in ipairs(done) do first_seed = math.min(first_seed, r.seed) end
-  local count, figures = 0, {}
-  local section
+  local figures, section = {}, nil
   local function draw(o)
     if fig.curves(o) then
-      count = count + 1
       figures[#figures + 1] = {file = "plots/" .. o.file:match("([^/]+)$"), title = o.title, section = section}
     end
   end
@@ -663,7 +661,7 @@ local function plots(dir, rows, curves, log)
          title = m .. ": energy terms at the end of the shear (thesis: friction ~0.8)", series = series,
          extra = "set xtics 1\n"}
   end
-  return count, figures
+  return figures
 end
 
 -- Event statistics -------------------------------------------------------------------------------
@@ -752,9 +750,15 @@ local function events(dir, rows, log)
   local xs, ns = ev.ccdf(pooled_sizes)
   size_series[#size_series + 1] = {title = ("pooled: b = %.2f +- %.2f (%d events)"):format(pb, pe, pn), x = xs, y = ns,
                                    style = "linespoints", color = "#000000", point = 5, width = 3}
-  fig.curves{file = edir .. "/sizes.png", logx = true, logy = true, xlabel = "event size S [broken bonds]",
-             ylabel = "events with size >= S", title = "break events (M = log10 S): each fracture run (thin), pooled (black)",
-             series = size_series, key = "top right"}
+  -- The pooled figures drawn, for trends.md (paths relative to the study folder).
+  local drawn = {}
+  local function pooled(name, o)
+    o.file = ("%s/%s.png"):format(edir, name)
+    if fig.curves(o) then drawn[#drawn + 1] = {file = ("events/%s.png"):format(name), title = o.title, section = "events"} end
+  end
+  pooled("sizes", {logx = true, logy = true, xlabel = "event size S [broken bonds]",
+                   ylabel = "events with size >= S", title = "break events (M = log10 S): each fracture run (thin), pooled (black)",
+                   series = size_series, key = "top right"})
   local out = {runs = #results, sampled_runs = sampled, pooled_events = #pooled_sizes, pooled_b = pb, pooled_b_error = pe,
                pooled_breaks = pooled_breaks,
                pooled_breaks_per_100_steps = pooled_intervals > 0 and pooled_breaks / pooled_intervals or 0/0,
@@ -779,8 +783,8 @@ local function events(dir, rows, log)
       lines[#lines + 1] = ("%d,%.6g,%.6g,%.6g"):format(lag, series[1].y[lag + 1], series[2].y[lag + 1], series[3].y[lag + 1])
     end
     write_atomic(edir .. "/xcorr.csv", table.concat(lines, "\n") .. "\n")
-    fig.curves{file = edir .. "/xcorr.png", xlabel = "lag [intervals]", ylabel = "correlation with the break count",
-               title = "breaks(t) against energy fluctuation(t + lag), pooled", series = series}
+    pooled("xcorr", {xlabel = "lag [intervals]", ylabel = "correlation with the break count",
+                     title = "breaks(t) against energy fluctuation(t + lag), pooled", series = series})
     local dseries = {}
     lines = {"z,kinetic,strain,damping"}
     local dens = {}
@@ -793,13 +797,13 @@ local function events(dir, rows, log)
       lines[#lines + 1] = ("%.4g,%.6g,%.6g,%.6g"):format(dens[1][1][i], dens[1][2][i], dens[2][2][i] or 0/0, dens[3][2][i] or 0/0)
     end
     write_atomic(edir .. "/fluctuations.csv", table.concat(lines, "\n") .. "\n")
-    fig.curves{file = edir .. "/fluctuations.png", logy = true, xlabel = "fluctuation / its SD",
-               ylabel = "probability density", title = "energy change per interval, pooled", series = dseries}
+    pooled("fluctuations", {logy = true, xlabel = "fluctuation / its SD",
+                            ylabel = "probability density", title = "energy change per interval, pooled", series = dseries})
   else
     out.note = "energies not sampled (joint.lua events_every=0): no fluctuations or cross-correlations"
   end
   write_atomic(edir .. "/events.json", asperity.json(out))
-  return out
+  return out, drawn
 end
 
 -- Everything ---------------------------------------------------------------------------------------
@@ -814,18 +818,10 @@ function M.write(o)
   write_atomic(dir .. "/study_cases.csv", cases_csv)
   local T = M.trends(rows, curves)
   write_atomic(dir .. "/trends.json", asperity.json({trends = T}))
-  local n, figures = plots(dir, rows, curves, log)
-  local e = events(dir, rows, log)
-  for _, name in ipairs{"sizes", "xcorr", "fluctuations"} do   -- the pooled event figures, where drawn
-    local f = io.open(("%s/events/%s.png"):format(dir, name))
-    if f then
-      f:close()
-      figures[#figures + 1] = {file = ("events/%s.png"):format(name), section = "events",
-                               title = ({sizes = "event sizes, pooled over the fracture runs",
-                                         xcorr = "cross-correlation of the energies with the break count",
-                                         fluctuations = "fluctuations of the energies"})[name]}
-    end
-  end
+  local figures = plots(dir, rows, curves, log)
+  local n = #figures
+  local e, pooled = events(dir, rows, log)
+  for _, f in ipairs(pooled or {}) do figures[#figures + 1] = f end
   write_atomic(dir .. "/trends.md", trends_markdown(T, rows) .. reference_markdown(rows) .. figures_markdown(figures))
   local shown = 0
   for _, t in ipairs(T) do if t.verdict == "shown" then shown = shown + 1 end end
