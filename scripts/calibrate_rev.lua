@@ -38,7 +38,7 @@ local P = params_lib.parse{
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "passed to rev.lua"},
   {"genesis_shrink_gain", mat.genesis.shrink_gain, above = 0, max = 1, doc = "passed to rev.lua"},
   {"genesis_mass_floor", mat.genesis.mass_floor, min = 0, max = 2, doc = "passed to rev.lua"},
-  {"genesis_damping", 0, min = 0, below = 1, doc = "passed to rev.lua"},
+  {"genesis_damping", mat.genesis.damping, min = 0, below = 1, doc = "passed to rev.lua"},
   {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "passed to rev.lua"},
   {"out", "out/calibration", nonempty = true, doc = "output folder (one folder per trial and seed)"},
   {"cache", "", doc = "packings cached here (\"\": out/cache)"},

@@ -61,7 +61,7 @@ local P = params_lib.parse{
   {"density", mat.density, unit = "kg/m^3", above = 0, doc = "particle density"},
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "isotropic stress the genesis installs before bonding (model units)"},
   {"genesis_shrink_gain", mat.genesis.shrink_gain, above = 0, max = 1, doc = "the stress servo's gain when it shrinks the radii, relative to when it grows them"},
-  {"genesis_damping", 0, min = 0, below = 1, doc = "> 0: the local damping of the packing steps (compaction and stress installation; `damping` again once packed); 0: `damping` throughout"},
+  {"genesis_damping", mat.genesis.damping, min = 0, below = 1, doc = "the local damping of the packing steps (compaction and stress installation; `damping` again once packed)"},
   {"genesis_mass_floor", mat.genesis.mass_floor, min = 0, max = 2, doc = "while packing, particles smaller than this x mean radius weigh as one of it (0: true masses)"},
   {"floater_contacts", mat.genesis.floater_contacts, type = "integer", min = 0,
    doc = "particles with fewer contacts are floaters"},
@@ -142,7 +142,7 @@ local function make_packing()
   local g = genesis.pack(w, {min = lo, max = hi, radii = r, seed = P.seed, box = box, stress = P.genesis_stress,
                              friction = P.friction, ratio = P.ratio, min_contacts = P.floater_contacts,
                              grow_floaters = P.grow_floaters, shrink_gain = P.genesis_shrink_gain,
-                             mass_floor = P.genesis_mass_floor, damping = P.genesis_damping > 0 and P.genesis_damping or nil,
+                             mass_floor = P.genesis_mass_floor, damping = P.genesis_damping,
                              mean_radius = P.mean_radius, log = log})
   local info = {n_particles = #g.kept, n_generated = n, genesis = g, box = box, kept = g.kept,
                 porosity_nominal = g.porosity_nominal, porosity_true = g.porosity_true,
@@ -165,7 +165,7 @@ local function cached_packing()
     .. (P.lock_rotation and ("_l%d"):format(P.rotation_lock_bonds) or "_free") .. (P.grow_floaters and "_grown" or "")
     .. (P.genesis_shrink_gain ~= 1 and ("_sg%.3g"):format(P.genesis_shrink_gain) or "")
     .. (P.genesis_mass_floor ~= 0 and ("_mf%.3g"):format(P.genesis_mass_floor) or "")
-    .. (P.genesis_damping > 0 and ("_gd%.3g"):format(P.genesis_damping) or "")
+    .. (P.genesis_damping ~= P.damping and ("_gd%.3g"):format(P.genesis_damping) or "")
   local h5, rec = P.cache .. "/" .. key .. ".h5", P.cache .. "/" .. key .. ".lua"
   local f = io.open(rec, "r")
   if f then

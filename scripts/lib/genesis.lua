@@ -15,7 +15,9 @@
 --      depend on where a frictional packing happened to lock. Until the stress is installed (step
 --      2), particles below `mass_floor` (materials.lua genesis.mass_floor, 1) x `mean_radius`
 --      weigh as one of that radius: the lightest particles set the critical time step, and the
---      packed state is an equilibrium, which masses do not enter (2.5x the step).
+--      packed state is an equilibrium, which masses do not enter (2.5x the step). Steps 1 and 2 run
+--      with the local damping `damping` (materials.lua genesis.damping, 0.3), the world's own after:
+--      the slow collective relaxation of a packing near jamming is what the damping holds back.
 --   2. a low isotropic stress installed by scaling the radii by one factor (M.install_stress, a
 --      servo) until the mean stress of the assembly (from its contacts, world:contact_stress) is
 --      `stress`; with `split(x, y, z)` -> 1..sets_count, each set (the halves of a joint) has its
@@ -106,8 +108,10 @@ end
 -- genesis.pack's default materials.lua genesis.shrink_gain, 1/4) shrinks more gently than it
 -- grows, so that a set above the target comes down to it with the relaxation instead of
 -- overshooting below and creeping back up (perf/README.md: 1.4-5.8x fewer steps on 5 cm joints,
--- the same floater share and coordination on average over seeds). Done when every set
--- is within `tolerance` of the target at `settled` updates running and the unbalanced-force
+-- the same floater share and coordination on average over seeds); growing, its gain doubles at
+-- each update below the band until the set is above the target. Done when the stress of every
+-- set, averaged over the last `settled` updates, is within `tolerance` of the target at
+-- `settled` updates running and the unbalanced-force
 -- ratio is below `ratio`, or, where the assembly creeps without settling that far, once its
 -- rattlers (particles with fewer than `min_contacts`, 3, contacts with particles) stop falling:
 -- their share, taken every `patience` updates within the tolerance, fell by less than
@@ -133,15 +137,26 @@ function M.install_stress(world, o)
     return r / math.max(1, n)
   end
   local share, last_share
-  local f, p, stiff = {}, {}, {}
-  for k = 1, #sets do f[k] = 1 end
+  local f, p, stiff, boost = {}, {}, {}, {}
+  for k = 1, #sets do f[k], boost[k] = 1, 1 end
+  local max_boost = o.max_boost or 1024
   local steps, updates, settled = 0, 0, 0
   local max_steps = o.max_steps or 1000000
   local function measure()
     for k = 1, #sets do p[k], stiff[k] = world:contact_stress(tags[k], volumes[k]) end
   end
+  -- Within the tolerance: each set's stress averaged over the last `settled_needed` updates (a
+  -- packing that still moves reads a few percent either way from one update to the next).
+  local recent = {}
+  for k = 1, #sets do recent[k] = {} end
   local function good()
-    for k = 1, #sets do if math.abs(p[k] - target) > tol * target then return false end end
+    for k = 1, #sets do
+      local r = recent[k]
+      if #r < settled_needed then return false end
+      local mean = 0
+      for i = #r - settled_needed + 1, #r do mean = mean + r[i] end
+      if math.abs(mean / settled_needed - target) > tol * target then return false end
+    end
     return true
   end
   pack.refresh_dt(world)
@@ -151,12 +166,22 @@ function M.install_stress(world, o)
     for k = 1, #sets do
       local df
       if stiff[k] > 0 then
-        df = (p[k] > target and shrink_gain or 1) * gain * (target - p[k]) / stiff[k]
+        df = (p[k] > target and shrink_gain or boost[k]) * gain * (target - p[k]) / stiff[k]
       else
         df = max_change      -- no contact in the set: grow towards jamming
       end
       df = math.max(-max_change, math.min(max_change, df))
       -- a dead band of half the tolerance: the set settles, and stays centred in the tolerance
+      -- Growing, the gain doubles at each update that finds the set below the band, until it is
+      -- above the target again: near jamming the affine stiffness overstates the true one ~600x,
+      -- so at gain 1 a set whose stress hovers about the band's lower edge creeps up for tens of
+      -- thousands of steps (a 5 cm half: 50 000). Above the target the relaxation helps and the
+      -- gain stays low (shrink_gain).
+      if p[k] >= target or stiff[k] == 0 then
+        boost[k] = 1
+      elseif p[k] < (1 - 0.5 * tol) * target then
+        boost[k] = math.min(2 * boost[k], max_boost)
+      end
       if math.abs(p[k] - target) > 0.5 * tol * target or stiff[k] == 0 then
         local change = (f[k] + df) / f[k]
         for _, id in ipairs(sets[k]) do world:set_radius(id, world:radius(id) * change) end
@@ -167,6 +192,11 @@ function M.install_stress(world, o)
     steps = steps + world:cycle(every)
     updates = updates + 1
     measure()
+    for k = 1, #sets do
+      local r = recent[k]
+      r[#r + 1] = p[k]
+      if #r > settled_needed then table.remove(r, 1) end
+    end
     if good() then settled = settled + 1 else settled = 0 end
     if o.log and updates % 25 == 0 then
       local t = {}
@@ -183,7 +213,14 @@ function M.install_stress(world, o)
       end
     end
   end
-  return {steps = steps, updates = updates, factors = f, stresses = p, reached = good(),
+  -- The stress each set holds: the mean over the updates the criterion read.
+  local held = {}
+  for k = 1, #sets do
+    local r, sum = recent[k], 0
+    for i = 1, #r do sum = sum + r[i] end
+    held[k] = #r > 0 and sum / #r or p[k]
+  end
+  return {steps = steps, updates = updates, factors = f, stresses = held, reached = good(),
           ratio = world:unbalanced_force_ratio(), rattlers = share or rattler_share()}
 end
 
@@ -350,7 +387,7 @@ function M.pack(world, o)
             compaction_ratio = true, compaction_steps = true, patience = true, stress_ratio = true,
             rattler_drop = true,
             grow_floaters = true, shrink_gain = true, mass_floor = true, mean_radius = true,
-            interior = true, damping = true}, "genesis.pack")
+            interior = true, damping = true, settle_steps = true}, "genesis.pack")
   assert(o.min and o.max and o.radii and o.box, "genesis.pack: min, max, radii and box are required")
   assert(o.stress and o.stress > 0, "genesis.pack: stress (Pa, > 0) is required")
   local log = o.log or function() end
@@ -360,12 +397,10 @@ function M.pack(world, o)
   -- nominal one) weigh as one of it (pack.expand): a longer time step for an end state that masses
   -- do not enter.
   local floor = (o.mass_floor or mat.genesis.mass_floor) * (o.mean_radius or mat.packing.mean_radius)
-  -- `damping`: the local damping of the packing steps (compaction and stress installation), the
-  -- world's own back after them; by default the world's throughout. (0.3 gathered a 10 cm
-  -- packing's rattlers in a third of the steps, but left one REV packing of ten with 99.9 % of its
-  -- bonds needing 0.337 st, above scenarios.md 1's third: perf/README.md.)
+  -- The local damping of the packing steps (compaction and stress installation; materials.lua
+  -- genesis.damping), the world's own back after them.
   local damping = world:settings().damping
-  if o.damping then world:set_damping(o.damping) end
+  world:set_damping(o.damping or mat.genesis.damping)
   -- 1. Frictionless compaction.
   world:set_friction(0)
   -- The compaction need not settle finely: the stress installation that follows does.
@@ -405,7 +440,20 @@ function M.pack(world, o)
   log("stress installed: radii x %s, mean stress %s Pa (target %.4g) in %d steps (%d neighbour builds so far), unbalanced-force ratio %.2g, rattlers %.1f %%%s",
       table.concat(fs, " / "), table.concat(ps, " / "), o.stress, s.steps, world:stats().rebuilds, s.ratio, 100 * s.rattlers,
       s.reached and "" or " (NOT reached)")
-  world:set_damping(damping)
+  -- The world's damping back, and the packing relaxed under it before the floaters are placed
+  -- and bonds installed: a packing at rest under a light damping still holds the small
+  -- collective motions that damping let build up, which otherwise end as bond stress when the
+  -- walls go (one REV packing of ten: 99.9 % of its bonds at 0.337 st without these steps,
+  -- 0.15-0.26 st with them).
+  local settle_steps = 0
+  if world:settings().damping ~= damping then
+    world:set_damping(damping)
+    settle_steps = world:cycle(o.settle_steps or mat.genesis.settle_steps)
+    local now = {}
+    for k = 1, nsets do now[k] = ("%.4g"):format(world:contact_stress(k, volumes[k])) end
+    log("settled %d steps at damping %.3g: mean stress %s Pa, unbalanced-force ratio %.2g",
+        settle_steps, damping, table.concat(now, " / "), world:unbalanced_force_ratio())
+  end
   -- The true masses back (pack.expand's mass floor): the state is an equilibrium, which they do
   -- not enter.
   if floor > 0 then
@@ -483,7 +531,8 @@ function M.pack(world, o)
     particles = last - first + 1, kept = kept, floaters = floaters, floaters_removed = #floaters,
     floaters_grown = #grown, floater_share = (#floaters + #grown) / math.max(1, last - first + 1),
     first = first, last = last,
-    compaction_steps = expanded.steps, stress_steps = s.steps, steps = expanded.steps + s.steps,
+    compaction_steps = expanded.steps, stress_steps = s.steps, settle_steps = settle_steps,
+    steps = expanded.steps + s.steps + settle_steps,
     rattlers = s.rattlers,
     radius_factor = s.factors[1], radius_factors = s.factors, stress_pa = s.stresses[1], stresses_pa = s.stresses,
     stress_target_pa = o.stress, stress_reached = s.reached, stress_ratio = s.ratio,

@@ -47,6 +47,10 @@ assert(g.floaters_removed < 0.25 * n, ("%d of %d particles were floaters"):forma
 assert(w:inert_count() == #g.floaters, "floaters are inert")
 assert(g.coordination > 3.5, ("coordination %.2f of the jammed assembly"):format(g.coordination))
 assert(g.porosity_true < g.porosity_nominal, "true porosity below the thesis's nominal one")
+-- Packed at genesis.damping, then settled at the world's own before the floaters and bonds.
+assert(mat.genesis.damping ~= mat.damping and g.settle_steps == mat.genesis.settle_steps,
+       ("%d settling steps at the world's damping"):format(g.settle_steps))
+assert(w:settings().damping == mat.damping, "the world's damping back after the packing")
 local ids = {}
 for _, id in pairs(box) do ids[#ids + 1] = id end
 local b = genesis.bond(w, {sets = {g.kept}, material = mat.bond(), walls = ids})

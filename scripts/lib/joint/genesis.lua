@@ -60,7 +60,7 @@ local function cache_file(P, s)
     .. (P.wall_friction ~= 0 and ("_f%.3g"):format(P.wall_friction) or "")
     .. (P.genesis_shrink_gain ~= 1 and ("_sg%.3g"):format(P.genesis_shrink_gain) or "")
     .. (P.genesis_mass_floor ~= 0 and ("_mf%.3g"):format(P.genesis_mass_floor) or "")
-    .. (P.genesis_damping > 0 and ("_gd%.3g"):format(P.genesis_damping) or "")
+    .. (P.genesis_damping ~= mat.damping and ("_gd%.3g"):format(P.genesis_damping) or "")
   return P.cache .. "/joint_" .. key .. ".h5"
 end
 
@@ -103,7 +103,7 @@ local function build(run)
                              stress = P.genesis_stress, friction = mat.contact.friction,
                              min_contacts = mat.genesis.floater_contacts, floater_tag = LOST,
                              grow_floaters = mat.genesis.grow_floaters, shrink_gain = P.genesis_shrink_gain,
-                             mass_floor = P.genesis_mass_floor, damping = P.genesis_damping > 0 and P.genesis_damping or nil,
+                             mass_floor = P.genesis_mass_floor, damping = P.genesis_damping,
                              progress = P.progress, max_steps = P.pack_steps,
                              log = log,
                              split = function(x, y, z) return z < surface_z(x, y) and 1 or 2 end,
