@@ -16,8 +16,9 @@
 --      2), particles below `mass_floor` (materials.lua genesis.mass_floor, 1) x `mean_radius`
 --      weigh as one of that radius: the lightest particles set the critical time step, and the
 --      packed state is an equilibrium, which masses do not enter (2.5x the step). Steps 1 and 2 run
---      with the local damping `damping` (materials.lua genesis.damping, 0.3), the world's own after:
---      the slow collective relaxation of a packing near jamming is what the damping holds back.
+--      with the local damping `damping` (materials.lua genesis.damping, 0.3): the slow collective
+--      relaxation of a packing near jamming is what the damping holds back. Step 2 is then done
+--      again under the world's own damping, which the packing is bonded and tested with.
 --   2. a low isotropic stress installed by scaling the radii by one factor (M.install_stress, a
 --      servo) until the mean stress of the assembly (from its contacts, world:contact_stress) is
 --      `stress`; with `split(x, y, z)` -> 1..sets_count, each set (the halves of a joint) has its
@@ -387,7 +388,7 @@ function M.pack(world, o)
             compaction_ratio = true, compaction_steps = true, patience = true, stress_ratio = true,
             rattler_drop = true,
             grow_floaters = true, shrink_gain = true, mass_floor = true, mean_radius = true,
-            interior = true, damping = true, settle_steps = true}, "genesis.pack")
+            interior = true, damping = true, finish_patience = true}, "genesis.pack")
   assert(o.min and o.max and o.radii and o.box, "genesis.pack: min, max, radii and box are required")
   assert(o.stress and o.stress > 0, "genesis.pack: stress (Pa, > 0) is required")
   local log = o.log or function() end
@@ -440,19 +441,29 @@ function M.pack(world, o)
   log("stress installed: radii x %s, mean stress %s Pa (target %.4g) in %d steps (%d neighbour builds so far), unbalanced-force ratio %.2g, rattlers %.1f %%%s",
       table.concat(fs, " / "), table.concat(ps, " / "), o.stress, s.steps, world:stats().rebuilds, s.ratio, 100 * s.rattlers,
       s.reached and "" or " (NOT reached)")
-  -- The world's damping back, and the packing relaxed under it before the floaters are placed
-  -- and bonds installed: a packing at rest under a light damping still holds the small
-  -- collective motions that damping let build up, which otherwise end as bond stress when the
-  -- walls go (one REV packing of ten: 99.9 % of its bonds at 0.337 st without these steps,
-  -- 0.15-0.26 st with them).
-  local settle_steps = 0
+  -- The world's damping back, and the stress installed again under it, the servo going on from
+  -- where it stands: a packing brought to the stress under a light damping still holds collective
+  -- motions, and at rest under the material's its stress fell by 1-44 % (2 000 steps; 10 cm: 19 %)
+  -- and one REV packing of ten left its bonds at 0.337 st. The rattlers are gathered by then, so
+  -- their criterion looks over `finish_patience` updates instead of 25.
+  local finish
   if world:settings().damping ~= damping then
     world:set_damping(damping)
-    settle_steps = world:cycle(o.settle_steps or mat.genesis.settle_steps)
-    local now = {}
-    for k = 1, nsets do now[k] = ("%.4g"):format(world:contact_stress(k, volumes[k])) end
-    log("settled %d steps at damping %.3g: mean stress %s Pa, unbalanced-force ratio %.2g",
-        settle_steps, damping, table.concat(now, " / "), world:unbalanced_force_ratio())
+    finish = M.install_stress(world, {sets = sets, tags = tags, volumes = volumes, target = o.stress,
+                                      tolerance = o.tolerance, ratio = o.stress_ratio or mat.genesis.ratio, max_steps = o.max_steps,
+                                      patience = o.finish_patience or mat.genesis.finish_patience,
+                                      rattler_drop = o.rattler_drop, min_contacts = o.min_contacts,
+                                      shrink_gain = o.shrink_gain or mat.genesis.shrink_gain,
+                                      log = o.progress and log or nil})
+    local fs2, ps2 = {}, {}
+    for k = 1, nsets do
+      s.factors[k] = s.factors[k] * finish.factors[k]
+      fs2[k], ps2[k] = ("%.5f"):format(finish.factors[k]), ("%.4g"):format(finish.stresses[k])
+    end
+    log("stress installed again at damping %.3g: radii x %s, mean stress %s Pa in %d steps, unbalanced-force ratio %.2g, rattlers %.1f %%%s",
+        damping, table.concat(fs2, " / "), table.concat(ps2, " / "), finish.steps, finish.ratio, 100 * finish.rattlers,
+        finish.reached and "" or " (NOT reached)")
+    s.stresses, s.reached, s.ratio, s.rattlers = finish.stresses, finish.reached, finish.ratio, finish.rattlers
   end
   -- The true masses back (pack.expand's mass floor): the state is an equilibrium, which they do
   -- not enter.
@@ -531,8 +542,8 @@ function M.pack(world, o)
     particles = last - first + 1, kept = kept, floaters = floaters, floaters_removed = #floaters,
     floaters_grown = #grown, floater_share = (#floaters + #grown) / math.max(1, last - first + 1),
     first = first, last = last,
-    compaction_steps = expanded.steps, stress_steps = s.steps, settle_steps = settle_steps,
-    steps = expanded.steps + s.steps + settle_steps,
+    compaction_steps = expanded.steps, stress_steps = s.steps, finish_steps = finish and finish.steps or 0,
+    steps = expanded.steps + s.steps + (finish and finish.steps or 0),
     rattlers = s.rattlers,
     radius_factor = s.factors[1], radius_factors = s.factors, stress_pa = s.stresses[1], stresses_pa = s.stresses,
     stress_target_pa = o.stress, stress_reached = s.reached, stress_ratio = s.ratio,
