@@ -36,8 +36,9 @@ M.packing = {mean_radius = 0.5e-3, radius_sd = 0.1e-3, cut = 3, porosity = 0.51}
 -- (it takes 70 % of every accelerating force [3-28]), so its rattlers gathered over 75 000 steps on
 -- a 10 cm joint against 24 000 at 0.3, to the same state (perf/README.md). The stress is then
 -- installed again at the material's damping, the rattler criterion over `finish_patience` updates:
--- at rest under it a packing's stress fell by up to 44 %, and one REV packing of ten left its
--- bonds at 0.337 st, above scenarios.md 1's third.
+-- brought to rest under it without the servo a packing's stress fell by up to 44 %, and bonded
+-- straight after the packing one REV packing of ten left its bonds at 0.337 st, above
+-- scenarios.md 1's third.
 M.genesis = {porosity = 0.45, stress = 8e-4, floater_contacts = 3, ratio = 1e-2, grow_floaters = true,
              mass_floor = 1, shrink_gain = 0.25, damping = 0.3, finish_patience = 5}
 
