@@ -94,7 +94,7 @@ local P = params_lib.parse{
   {"porosity", mat.genesis.porosity, above = 0, below = 1, doc = "thesis definition [3-35]: the particle count of the genesis"},
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "isotropic stress installed before bonding (scenarios.md 1; model units)"},
   {"genesis_shrink_gain", mat.genesis.shrink_gain, above = 0, max = 1, doc = "the stress servo's gain when it shrinks the radii, relative to when it grows them (< 1: it comes down to the target with the relaxation)"},
-  {"genesis_damping", mat.genesis.damping, min = 0, below = 1, doc = "the local damping of the packing steps (compaction and stress installation; the material's again once packed)"},
+  {"genesis_damping", mat.genesis.damping, min = 0, below = 1, doc = "the local damping of the packing steps (compaction and stress installation, the stress then installed again at the material's)"},
   {"genesis_mass_floor", mat.genesis.mass_floor, min = 0, max = 2, doc = "while packing, particles smaller than this x mean radius weigh as one of it (a larger time step; 0: true masses)"},
   {"bond_gap", 0, unit = "m", min = 0, doc = "largest gap bonded (0: the engine's default, 1e-3 x mean radius)"},
   {"tensile_strength", mat.rev.bond_tensile_strength, unit = "Pa", above = 0,

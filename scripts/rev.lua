@@ -61,7 +61,7 @@ local P = params_lib.parse{
   {"density", mat.density, unit = "kg/m^3", above = 0, doc = "particle density"},
   {"genesis_stress", mat.genesis.stress, unit = "Pa", above = 0, doc = "isotropic stress the genesis installs before bonding (model units)"},
   {"genesis_shrink_gain", mat.genesis.shrink_gain, above = 0, max = 1, doc = "the stress servo's gain when it shrinks the radii, relative to when it grows them"},
-  {"genesis_damping", mat.genesis.damping, min = 0, below = 1, doc = "the local damping of the packing steps (compaction and stress installation; `damping` again once packed)"},
+  {"genesis_damping", mat.genesis.damping, min = 0, below = 1, doc = "the local damping of the packing steps (compaction and stress installation, the stress then installed again at `damping`)"},
   {"genesis_mass_floor", mat.genesis.mass_floor, min = 0, max = 2, doc = "while packing, particles smaller than this x mean radius weigh as one of it (0: true masses)"},
   {"floater_contacts", mat.genesis.floater_contacts, type = "integer", min = 0,
    doc = "particles with fewer contacts are floaters"},
@@ -160,7 +160,7 @@ end
 local function cached_packing()
   if P.cache == "" then return make_packing() end
   asperity.mkdir(P.cache)
-  local key = ("rev_v5_L%.6g_n%.6g_s%d_r%.6g_%.6g_k%.6g_%.6g_d%.6g_%.6g_g%.6g_f%d_q%.6g"):format(P.size, P.porosity,
+  local key = ("rev_v6_L%.6g_n%.6g_s%d_r%.6g_%.6g_k%.6g_%.6g_d%.6g_%.6g_g%.6g_f%d_q%.6g"):format(P.size, P.porosity,
     P.seed, P.mean_radius, P.radius_sd, P.kn, P.ks, P.damping, P.density, P.genesis_stress, P.floater_contacts, P.ratio)
     .. (P.lock_rotation and ("_l%d"):format(P.rotation_lock_bonds) or "_free") .. (P.grow_floaters and "_grown" or "")
     .. (P.genesis_shrink_gain ~= 1 and ("_sg%.3g"):format(P.genesis_shrink_gain) or "")

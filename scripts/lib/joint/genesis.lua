@@ -54,7 +54,7 @@ end
 -- The cache file of the specimen, keyed by everything that shaped it.
 local function cache_file(P, s)
   local key = ("%s_%s_n%d_h%.6g_T%.6g_p%.4g_s%d_g%.6g_k%d_gs%.4g_fc%d_l%d_b%.4g_%.4g_gap%.4g"):format(
-    P.surface_file ~= "" and P.surface_file:gsub("[^%w]", "_") or P.surface, mat.genesis.grow_floaters and "v11" or "v8", s.n, s.h, P.thickness,
+    P.surface_file ~= "" and P.surface_file:gsub("[^%w]", "_") or P.surface, mat.genesis.grow_floaters and "v12" or "v8", s.n, s.h, P.thickness,
     P.porosity, P.seed, P.gap, P.pack_steps, P.genesis_stress, mat.genesis.floater_contacts,
     mat.rev.rotation_lock_bonds, mat.rev.bond_shear_ratio, mat.rev.bond_radius_factor, P.bond_gap)
     .. (P.wall_friction ~= 0 and ("_f%.3g"):format(P.wall_friction) or "")
