@@ -108,8 +108,8 @@ end
 -- the relaxation instead of waiting for an equilibrium at each trial factor. `shrink_gain` (< 1;
 -- genesis.pack's default materials.lua genesis.shrink_gain, 1/4) shrinks more gently than it
 -- grows, so that a set above the target comes down to it with the relaxation instead of
--- overshooting below and creeping back up (perf/README.md: 1.4-5.8x fewer steps on 5 cm joints,
--- the same floater share and coordination on average over seeds); growing, its gain doubles at
+-- overshooting below and creeping back up (perf/README.md: on three 5 cm joints 50 625 steps
+-- against 68 716 at the full gain, the same state on average); growing, its gain doubles at
 -- each update below the band until the set is above the target. Done when the stress of every
 -- set, averaged over the last `settled` updates, is within `tolerance` of the target at
 -- `settled` updates running and the unbalanced-force
@@ -431,40 +431,37 @@ function M.pack(world, o)
   -- 2. The isotropic stress, by one radius factor per set, still without friction (unloading with
   -- friction to the low stress loses a third of the contacts: 32 % floaters, coordination 3.9, on
   -- the 1 cm REV).
-  local s = M.install_stress(world, {sets = sets, tags = tags, volumes = volumes, target = o.stress,
-                                     tolerance = o.tolerance, ratio = o.stress_ratio or mat.genesis.ratio, max_steps = o.max_steps, patience = o.patience,
-                                     rattler_drop = o.rattler_drop, min_contacts = o.min_contacts,
-                                     shrink_gain = o.shrink_gain or mat.genesis.shrink_gain,
-                                     log = o.progress and log or nil})
-  local fs, ps = {}, {}
-  for k = 1, nsets do fs[k], ps[k] = ("%.5f"):format(s.factors[k]), ("%.4g"):format(s.stresses[k]) end
-  log("stress installed: radii x %s, mean stress %s Pa (target %.4g) in %d steps (%d neighbour builds so far), unbalanced-force ratio %.2g, rattlers %.1f %%%s",
-      table.concat(fs, " / "), table.concat(ps, " / "), o.stress, s.steps, world:stats().rebuilds, s.ratio, 100 * s.rattlers,
-      s.reached and "" or " (NOT reached)")
+  local function install(patience)
+    return M.install_stress(world, {sets = sets, tags = tags, volumes = volumes, target = o.stress,
+                                    tolerance = o.tolerance, ratio = o.stress_ratio or mat.genesis.ratio, max_steps = o.max_steps,
+                                    patience = patience, rattler_drop = o.rattler_drop, min_contacts = o.min_contacts,
+                                    shrink_gain = o.shrink_gain or mat.genesis.shrink_gain,
+                                    log = o.progress and log or nil})
+  end
+  local function report(what, r, digits)
+    local fs, ps = {}, {}
+    for k = 1, nsets do fs[k], ps[k] = ("%." .. digits .. "f"):format(r.factors[k]), ("%.4g"):format(r.stresses[k]) end
+    log("%s: radii x %s, mean stress %s Pa (target %.4g) in %d steps (%d neighbour builds so far), unbalanced-force ratio %.2g, rattlers %.1f %%%s",
+        what, table.concat(fs, " / "), table.concat(ps, " / "), o.stress, r.steps, world:stats().rebuilds, r.ratio, 100 * r.rattlers,
+        r.reached and "" or " (NOT reached)")
+  end
+  local s = install(o.patience)
+  report("stress installed", s, 5)
   -- The world's damping back, and the stress installed again under it, the servo going on from
   -- where it stands: a packing brought to the stress under a light damping still holds collective
   -- motions: brought to rest under the material's without the servo (2 000 steps) its stress moved
   -- by +3 to -44 %, and bonded straight away one REV packing of ten left its bonds at 0.337 st
-  -- (scenarios.md 1 asks for st / 3 at most). The rattlers are gathered by then, so
-  -- their criterion looks over `finish_patience` updates instead of 25.
-  local finish
+  -- (scenarios.md 1 asks for st / 3 at most). The rattlers are gathered by then, so their
+  -- criterion looks over `finish_patience` updates instead of 25. Its radius factors change by
+  -- 1e-5 or less, hence the digits.
+  local finish_steps = 0
   if world:settings().damping ~= damping then
     world:set_damping(damping)
-    finish = M.install_stress(world, {sets = sets, tags = tags, volumes = volumes, target = o.stress,
-                                      tolerance = o.tolerance, ratio = o.stress_ratio or mat.genesis.ratio, max_steps = o.max_steps,
-                                      patience = o.finish_patience or mat.genesis.finish_patience,
-                                      rattler_drop = o.rattler_drop, min_contacts = o.min_contacts,
-                                      shrink_gain = o.shrink_gain or mat.genesis.shrink_gain,
-                                      log = o.progress and log or nil})
-    local fs2, ps2 = {}, {}
-    for k = 1, nsets do
-      s.factors[k] = s.factors[k] * finish.factors[k]
-      fs2[k], ps2[k] = ("%.7f"):format(finish.factors[k]), ("%.4g"):format(finish.stresses[k])
-    end
-    log("stress installed again at damping %.3g: radii x %s, mean stress %s Pa in %d steps, unbalanced-force ratio %.2g, rattlers %.1f %%%s",
-        damping, table.concat(fs2, " / "), table.concat(ps2, " / "), finish.steps, finish.ratio, 100 * finish.rattlers,
-        finish.reached and "" or " (NOT reached)")
+    local finish = install(o.finish_patience or mat.genesis.finish_patience)
+    report(("stress installed again at damping %.3g"):format(damping), finish, 7)
+    for k = 1, nsets do s.factors[k] = s.factors[k] * finish.factors[k] end
     s.stresses, s.reached, s.ratio, s.rattlers = finish.stresses, finish.reached, finish.ratio, finish.rattlers
+    finish_steps = finish.steps
   end
   -- The true masses back (pack.expand's mass floor): the state is an equilibrium, which they do
   -- not enter.
@@ -543,8 +540,8 @@ function M.pack(world, o)
     particles = last - first + 1, kept = kept, floaters = floaters, floaters_removed = #floaters,
     floaters_grown = #grown, floater_share = (#floaters + #grown) / math.max(1, last - first + 1),
     first = first, last = last,
-    compaction_steps = expanded.steps, stress_steps = s.steps, finish_steps = finish and finish.steps or 0,
-    steps = expanded.steps + s.steps + (finish and finish.steps or 0),
+    compaction_steps = expanded.steps, stress_steps = s.steps, finish_steps = finish_steps,
+    steps = expanded.steps + s.steps + finish_steps,
     rattlers = s.rattlers,
     radius_factor = s.factors[1], radius_factors = s.factors, stress_pa = s.stresses[1], stresses_pa = s.stresses,
     stress_target_pa = o.stress, stress_reached = s.reached, stress_ratio = s.ratio,

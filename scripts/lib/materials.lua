@@ -29,8 +29,8 @@ M.packing = {mean_radius = 0.5e-3, radius_sd = 0.1e-3, cut = 3, porosity = 0.51}
 -- the critical time step [3-30], and the packed state is an equilibrium, which masses do not enter
 -- (2.5x the time step; the same floater share at 1, 2 and 5 cm, where true masses left
 -- 13-20 %). The stress servo shrinks the radii at a quarter of its gain
--- (`shrink_gain`), coming down to the stress with the relaxation: 1.4-5.8x fewer steps on 5 cm
--- joints, the same state on average over seeds (perf/README.md). The packing steps run with a
+-- (`shrink_gain`), coming down to the stress with the relaxation: 1.4x fewer steps on three 5 cm
+-- joints, the same state on average (perf/README.md). The packing steps run with a
 -- local damping of 0.3 (`damping`; the material's 0.7 again once packed): near jamming a
 -- frictionless packing relaxes by slow collective motions, which strong local damping holds back
 -- (it takes 70 % of every accelerating force [3-28]), so its rattlers gathered over 75 000 steps on
