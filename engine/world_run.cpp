@@ -147,6 +147,10 @@ void World::set_rotation_lock_bonds(double k) {
   state_->settings.rotation_lock_bonds = int(k);
   detail::refresh_bond_topology(*state_);  // the locks by the new rule
 }
+void World::set_rotation_lock_beams(bool beams_only) {
+  state_->settings.rotation_lock_beams = beams_only;
+  detail::refresh_bond_topology(*state_);  // the locks by the new rule
+}
 void World::set_overlap_limit(double r) {
   check_setting("set_overlap_limit", "overlap_limit", r);
   state_->settings.overlap_limit = r;

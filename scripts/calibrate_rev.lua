@@ -30,6 +30,7 @@ local P = params_lib.parse{
   {"bond_shear_ratio", mat.rev.bond_shear_ratio, min = 0, doc = "passed to rev.lua"},
   {"bond_radius_factor", mat.rev.bond_radius_factor, above = 0, max = 1, doc = "passed to rev.lua"},
   {"rotation_lock_bonds", mat.rev.rotation_lock_bonds, type = "integer", min = 1, doc = "passed to rev.lua"},
+  {"rotation_lock_beams", mat.rev.rotation_lock_beams, doc = "passed to rev.lua"},
   {"bond_gap", 0, unit = "m", min = 0, doc = "passed to rev.lua"},
   {"contact_strength", mat.rev.contact_strength, type = "string", doc = "passed to rev.lua (c > 0, \"inf\" or \"beam\")"},
   {"contact_shear_strength", mat.rev.contact_shear_strength, type = "string", doc = "passed to rev.lua (cs > 0, \"inf\" or \"same\")"},
@@ -65,7 +66,7 @@ local rev_script = asperity.scripts_dir .. "/rev.lua"
 local function rev(st, tests, seed, name)
   params = {tensile_strength = st, tests = tests, seed = seed, cache = cache,
             bond_shear_ratio = P.bond_shear_ratio, bond_radius_factor = P.bond_radius_factor,
-            rotation_lock_bonds = P.rotation_lock_bonds, bond_gap = P.bond_gap,
+            rotation_lock_bonds = P.rotation_lock_bonds, rotation_lock_beams = P.rotation_lock_beams, bond_gap = P.bond_gap,
             contact_strength = P.contact_strength, contact_shear_strength = P.contact_shear_strength,
             contact_bond_friction = P.contact_bond_friction,
             grow_floaters = P.grow_floaters,

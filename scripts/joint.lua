@@ -101,6 +101,8 @@ local P = params_lib.parse{
    doc = "fracture model: bond strength st (model units; the REV's calibrated one by default)"},
   {"rotation_lock_bonds", mat.rev.rotation_lock_bonds, type = "integer", min = 1,
    doc = "fracture model: a damaged particle rotates once it holds fewer bonds (1: the thesis's rule; model.md 2)"},
+  {"rotation_lock_beams", mat.rev.rotation_lock_beams,
+   doc = "fracture model: only bonds whose parallel bond holds lock rotation (false: a contact bond alone too; model.md 5)"},
   {"contact_strength", mat.rev.contact_strength, type = "string",
    doc = "fracture model: the contact bonds break at c st A: c > 0, \"inf\" (never) or \"beam\" (with the parallel bond) (model.md 5)"},
   {"contact_shear_strength", mat.rev.contact_shear_strength, type = "string",

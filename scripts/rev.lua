@@ -88,6 +88,7 @@ local P = params_lib.parse{
   {"lock_rotation", true, doc = "model.md 2: bonded particles do not rotate"},
   {"rotation_lock_bonds", rev.rotation_lock_bonds, type = "integer", min = 1,
    doc = "... while they hold at least this many intact bonds"},
+  {"rotation_lock_beams", rev.rotation_lock_beams, doc = "only bonds whose parallel bond holds count for the lock (false: a contact bond alone too; model.md 5)"},
   {"bond_gap", 0, unit = "m", min = 0, doc = "largest gap bonded (0: the engine's default, 1e-3 x mean radius)"},
   {"dt_safety", 0, min = 0, max = 2, doc = "time step / critical estimate in the tests (0: the engine's 0.8; above 1 only to study instability)"},
   {"cache", "", doc = "a folder: the packing is cached there and reused (calibrate_rev.lua)"},
@@ -128,7 +129,7 @@ local function log(fmt, ...) io.write((fmt .. "\n"):format(...)); io.flush() end
 local function new_world()
   return asperity.world{material = {kn = P.kn, ks = P.ks, friction = P.friction}, damping = P.damping,
                         density = P.density, threads = P.threads, lock_bonded_rotation = P.lock_rotation,
-                        rotation_lock_bonds = P.rotation_lock_bonds}
+                        rotation_lock_bonds = P.rotation_lock_bonds, rotation_lock_beams = P.rotation_lock_beams}
 end
 
 -- 1. Genesis [scenarios.md 1] ---------------------------------------------------------------------
@@ -162,7 +163,8 @@ local function cached_packing()
   asperity.mkdir(P.cache)
   local key = ("rev_v6_L%.6g_n%.6g_s%d_r%.6g_%.6g_k%.6g_%.6g_d%.6g_%.6g_g%.6g_f%d_q%.6g"):format(P.size, P.porosity,
     P.seed, P.mean_radius, P.radius_sd, P.kn, P.ks, P.damping, P.density, P.genesis_stress, P.floater_contacts, P.ratio)
-    .. (P.lock_rotation and ("_l%d"):format(P.rotation_lock_bonds) or "_free") .. (P.grow_floaters and "_grown" or "")
+    .. (P.lock_rotation and ("_l%d"):format(P.rotation_lock_bonds) or "_free") .. (P.rotation_lock_beams and "_lb" or "")
+    .. (P.grow_floaters and "_grown" or "")
     .. (P.genesis_shrink_gain ~= 1 and ("_sg%.3g"):format(P.genesis_shrink_gain) or "")
     .. (P.genesis_mass_floor ~= 0 and ("_mf%.3g"):format(P.genesis_mass_floor) or "")
     .. (P.genesis_damping ~= P.damping and ("_gd%.3g"):format(P.genesis_damping) or "")

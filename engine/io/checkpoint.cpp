@@ -30,7 +30,7 @@ namespace asperity {
 namespace {
 
 using detail::State;
-constexpr int kCheckpointVersion = 11;  // 2: servo integral and integral time, group damping;
+constexpr int kCheckpointVersion = 12;  // 2: servo integral and integral time, group damping;
                                        // 3: rest overlaps (stress-free bonds);
                                        // 4: meshes' candidates within half the skin;
                                        // 5: a header with a checksum in the HDF5 user block;
@@ -41,7 +41,8 @@ constexpr int kCheckpointVersion = 11;  // 2: servo integral and integral time, 
                                        //    contact_strength, the kind of a break);
                                        // 10: the groups' impulse (a resumed run's interval means);
                                        // 11: the lazy groups' idle split and pending shift, so that
-                                       //     saving does not bring idle members up to date
+                                       //     saving does not bring idle members up to date;
+                                       // 12: rotation_lock_beams
 
 // The file's kind in the header of its HDF5 user block (io::h5::file_image), whose checksum is
 // verified before HDF5 parses the file: HDF5 does not survive every corruption of its metadata.

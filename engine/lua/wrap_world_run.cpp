@@ -187,6 +187,12 @@ int set_world_number(lua_State* L) {
     return 0;
   });
 }
+int world_set_rotation_lock_beams(lua_State* L) {
+  return guarded(L, [&] {
+    world_arg(L).set_rotation_lock_beams(check_boolean(L, 2));
+    return 0;
+  });
+}
 int world_critical_dt(lua_State* L) {
   return guarded(L, [&] { lua_pushnumber(L, world_arg(L).critical_dt()); return 1; });
 }
@@ -273,6 +279,9 @@ std::span<const Function> world_run_methods() {
       {"set_rotation_lock_bonds", set_world_number<&World::set_rotation_lock_bonds>, "world:set_rotation_lock_bonds(k)",
        "A particle with a bond does not rotate; once one of its bonds broke, only while it holds k\n"
        "(1: the thesis's rule, every bonded particle locked; model.md 2)."},
+      {"set_rotation_lock_beams", world_set_rotation_lock_beams, "world:set_rotation_lock_beams(b)",
+       "true: only a bond whose parallel bond holds locks its particles' rotation; false (the default):\n"
+       "a bond either part of which holds, the contact bond alone too (model.md 5)."},
       {"set_overlap_limit", set_world_number<&World::set_overlap_limit>, "world:set_overlap_limit(r)",
        "The health check's deepest overlap, in radii of the smaller body (default 1; 0 < r < 2).\n"
        "Deeper, one centre is inside the other particle; a rigid block's contacts may go there."},

@@ -49,10 +49,23 @@ void refresh_bond_topology(State& s) {
   // intact bonds. So the lock holds while intact >= min(rotation_lock_bonds, installed): damage
   // frees the inside of the material (compression softens, scenarios.md 2.5), and an intact
   // particle with few bonds, as on a joint's face, stays locked until it is damaged.
+  // Which bonds count (model.md 5): a pair either part of which holds (the partners), or with
+  // rotation_lock_beams only those whose parallel bond holds; installed = listed + fully broken.
+  std::vector<std::int32_t> beams;
+  if (s.settings.rotation_lock_beams) {
+    beams.assign(p.n, 0);
+    for_each_bond(s, [&](const BondStore& b, std::size_t k) {
+      if (static_cast<int>(b.holds[k]) & int(kBeamHolds)) {
+        ++beams[b.a[k]];
+        ++beams[b.b[k]];
+      }
+    });
+  }
   s.any_rotating = false;
   for (std::size_t i = 0; i < p.n; ++i) {
-    const std::int64_t intact = s.cache.partner_start[i + 1] - s.cache.partner_start[i];
-    const std::int64_t needed = std::min<std::int64_t>(s.settings.rotation_lock_bonds, intact + p.bonds_broken[i]);
+    const std::int64_t listed = s.cache.partner_start[i + 1] - s.cache.partner_start[i];
+    const std::int64_t intact = s.settings.rotation_lock_beams ? beams[i] : listed;
+    const std::int64_t needed = std::min<std::int64_t>(s.settings.rotation_lock_bonds, listed + p.bonds_broken[i]);
     const bool bonded = intact >= 1 && intact >= needed;
     const bool locked = !s.settings.rotation || p.user_rotation_locked[i] ||
                         (s.settings.lock_bonded_rotation && bonded);

@@ -61,6 +61,7 @@ struct WorldSettings {
   int reorder_interval = 10;
   bool lock_bonded_rotation = true;
   int rotation_lock_bonds = 1;
+  bool rotation_lock_beams = false;
   double overlap_limit = 1.0;
 };
 
@@ -115,6 +116,10 @@ void for_each_setting(Settings& s, Visit&& visit) {
               "a bonded particle none of whose bonds broke is locked; a damaged one while it still "
               "holds at least this many intact bonds"},
         s.rotation_lock_bonds);
+  visit(Field{"rotation_lock_beams", "rotation_lock_beams", 12, {},
+              "true: only bonds whose parallel bond holds lock rotation (model.md 5's alternative); "
+              "false: a bond either part of which holds"},
+        s.rotation_lock_beams);
   visit(Field{"overlap_limit", "overlap_limit", 8, {0, 2, true, true},
               "health: the deepest contact or bond overlap allowed, in radii of its smaller body "
               "(a rigid block's contacts may pass deeper than 1)"},
@@ -512,6 +517,8 @@ class World {
   // The rotation lock's count rule (WorldSettings::rotation_lock_bonds; 1: the thesis's rule, a
   // particle holding a bond does not rotate), applied at once.
   void set_rotation_lock_bonds(double k);
+  // Which bonds the lock counts (WorldSettings::rotation_lock_beams), applied at once.
+  void set_rotation_lock_beams(bool beams_only);
   void set_friction(double mu);           // ball-ball Coulomb coefficient from now on (>= 0)
   void set_damping(double alpha);         // local damping [3-28] from the next step on, [0, 1)
   double critical_dt();                   // estimate now [3-30..3-32], without safety factor

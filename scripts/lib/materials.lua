@@ -63,6 +63,9 @@ M.rev = {
   -- A bonded particle does not rotate (1: the thesis's rule); with k > 1 a damaged one only while
   -- it still holds k (model.md 2; neighbor/topology.cpp).
   rotation_lock_bonds = 1,
+  -- true: only bonds whose parallel bond holds lock rotation (model.md 5's alternative; false: a
+  -- pair either part of which holds).
+  rotation_lock_beams = false,
   -- The contact bond's strength factor c (model.md 5: Fcn = Fcs = c st A): "beam" breaks it with
   -- the parallel bond, "inf" never, a number > 0 at c st A.
   contact_strength = "1.75",

@@ -591,6 +591,51 @@ TEST(Bonds, AnIntactParticleStaysLockedAndADamagedOneWhileItHoldsTheThreshold) {
   EXPECT_TRUE(locked(loaded, back));
 }
 
+// rotation_lock_beams (model.md 5's alternative): only bonds whose parallel bond holds lock a
+// particle. A free particle between two anchors pulled apart: both beams break, the contact bonds
+// (c = inf) hold; by default it stays locked, counting beams only it turns, and a checkpoint keeps
+// the rule.
+TEST(Bonds, CountingBeamsOnlyAParticleHeldByContactBondsAloneTurns) {
+  World w;
+  const auto free = w.add_particle({0, 0, 0}, kR);
+  const auto above = w.add_particle({0, 0, 2 * kR}, kR);
+  const auto below = w.add_particle({0, 0, -2 * kR}, kR);
+  BondMaterial bm;
+  bm.tensile_strength = 2.0;  // Pa
+  bm.contact_strength = std::numeric_limits<double>::infinity();
+  ASSERT_EQ(w.install_bonds(bm), 2u);
+  auto locked = [](World& world, std::int64_t id) {
+    try {
+      world.set_angular_velocity(id, {0, 0, 0});
+      return false;
+    } catch (const Error&) {
+      return true;
+    }
+  };
+  GroupMotion fixed;
+  fixed.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
+  const int ga = w.add_group(std::vector<std::int64_t>{above}, moving({0, 0, 1e-6}));
+  const int gb = w.add_group(std::vector<std::int64_t>{below}, moving({0, 0, -1e-6}));
+  while (w.bond_count() > 0 && w.step_count() < 2000000) w.cycle(1);
+  w.set_group_motion(ga, fixed);
+  w.set_group_motion(gb, fixed);
+  ASSERT_EQ(w.bond_count(), 0u) << "both beams broke";
+  ASSERT_EQ(w.bonds().size(), 2u) << "the contact bonds hold";
+  EXPECT_FALSE(w.settings().rotation_lock_beams);
+  EXPECT_TRUE(locked(w, free)) << "by default a contact bond alone locks";
+  w.set_rotation_lock_beams(true);
+  EXPECT_FALSE(locked(w, free)) << "no parallel bond holds: it turns";
+  w.cycle(10);
+  EXPECT_FALSE(locked(w, free));
+  const std::string path = ::testing::TempDir() + "/beam_locks.h5";
+  w.save(path);
+  World loaded = World::load(path, 1, "auto");
+  EXPECT_TRUE(loaded.settings().rotation_lock_beams);
+  EXPECT_FALSE(locked(loaded, free));
+  w.set_rotation_lock_beams(false);
+  EXPECT_TRUE(locked(w, free)) << "the default rule back";
+}
+
 TEST(Bonds, InstallationBondsEveryTouchingPairOnce) {
   World w;
   const int n = 5;

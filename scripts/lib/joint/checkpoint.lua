@@ -29,7 +29,7 @@ local FREE = {threads = true, genesis_threads = true, progress = true, checkpoin
               save = true, out = true}
 -- Parameters joint.lua gained after states were saved: a state saved without one was made with
 -- this value (the behaviour before it existed), so it resumes where that value is given.
-local MADE_WITHOUT = {mass_floor = 0, genesis_mass_floor = 0, genesis_damping = 0.7}
+local MADE_WITHOUT = {mass_floor = 0, genesis_mass_floor = 0, genesis_damping = 0.7, rotation_lock_beams = false}
 -- The run's fields (joint/context.lua) that the closure and the shear change and the report reads.
 local RUN_FIELDS = {"ramp_steps", "moved_steps", "overlap_max", "overlap_at", "escaped_count", "escape_box",
                     "z_contact", "normal_stiffness", "applied_z", "axis", "c0", "e0", "dynamic_ratio",

@@ -91,6 +91,7 @@ local function bonded(run)
                             contact_shear_strength = (mat.contact_shear_strength(P.contact_shear_strength)),
                             contact_bond_friction = P.contact_bond_friction}
     world:set_rotation_lock_bonds(P.rotation_lock_bonds)
+    world:set_rotation_lock_beams(P.rotation_lock_beams)
   end
   -- Platens: the layer of each outer face. With the shear box, the side faces' layers too: a half
   -- whose sides are free carries the shear through its bulk as shear stress, and at a peak of
