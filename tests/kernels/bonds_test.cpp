@@ -52,6 +52,16 @@ GroupMotion moving(Vec3 v, Vec3 w = {}) {
   return m;
 }
 
+// A particle whose rotation is locked refuses an angular velocity.
+bool locked(World& world, std::int64_t id) {
+  try {
+    world.set_angular_velocity(id, {0, 0, 0});
+    return false;
+  } catch (const Error&) {
+    return true;
+  }
+}
+
 const double kArea = std::numbers::pi * kR * kR;
 }  // namespace
 
@@ -556,14 +566,6 @@ TEST(Bonds, AnIntactParticleStaysLockedAndADamagedOneWhileItHoldsTheThreshold) {
   const int gn = w.add_group(std::vector<std::int64_t>{north}, fixed);
   const int gs = w.add_group(std::vector<std::int64_t>{south}, fixed);
   const int gt = w.add_group(std::vector<std::int64_t>{tip}, fixed);
-  auto locked = [](World& world, std::int64_t id) {
-    try {
-      world.set_angular_velocity(id, {0, 0, 0});
-      return false;
-    } catch (const Error&) {
-      return true;
-    }
-  };
   auto pull = [&](int group, Vec3 v) {
     GroupMotion m;
     m.translation = {Dof::velocity, Dof::velocity, Dof::velocity};
@@ -604,14 +606,6 @@ TEST(Bonds, CountingBeamsOnlyAParticleHeldByContactBondsAloneTurns) {
   bm.tensile_strength = 2.0;  // Pa
   bm.contact_strength = std::numeric_limits<double>::infinity();
   ASSERT_EQ(w.install_bonds(bm), 2u);
-  auto locked = [](World& world, std::int64_t id) {
-    try {
-      world.set_angular_velocity(id, {0, 0, 0});
-      return false;
-    } catch (const Error&) {
-      return true;
-    }
-  };
   GroupMotion fixed;
   fixed.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
   const int ga = w.add_group(std::vector<std::int64_t>{above}, moving({0, 0, 1e-6}));
