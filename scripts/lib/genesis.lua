@@ -148,15 +148,18 @@ function M.install_stress(world, o)
   end
   -- Within the tolerance: each set's stress averaged over the last `settled_needed` updates (a
   -- packing that still moves reads a few percent either way from one update to the next).
+  -- `recent[k]` keeps the last `settled_needed` of them.
   local recent = {}
   for k = 1, #sets do recent[k] = {} end
+  local function mean(r)
+    local sum = 0
+    for i = 1, #r do sum = sum + r[i] end
+    return sum / #r
+  end
   local function good()
     for k = 1, #sets do
       local r = recent[k]
-      if #r < settled_needed then return false end
-      local mean = 0
-      for i = #r - settled_needed + 1, #r do mean = mean + r[i] end
-      if math.abs(mean / settled_needed - target) > tol * target then return false end
+      if #r < settled_needed or math.abs(mean(r) - target) > tol * target then return false end
     end
     return true
   end
@@ -216,11 +219,7 @@ function M.install_stress(world, o)
   end
   -- The stress each set holds: the mean over the updates the criterion read.
   local held = {}
-  for k = 1, #sets do
-    local r, sum = recent[k], 0
-    for i = 1, #r do sum = sum + r[i] end
-    held[k] = #r > 0 and sum / #r or p[k]
-  end
+  for k = 1, #sets do held[k] = #recent[k] > 0 and mean(recent[k]) or p[k] end
   return {steps = steps, updates = updates, factors = f, stresses = held, reached = good(),
           ratio = world:unbalanced_force_ratio(), rattlers = share or rattler_share()}
 end
