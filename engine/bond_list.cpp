@@ -94,25 +94,21 @@ void process_breaks(State& s) {
   s.ctx.bond_block_breaks.clear();
   if (any == 0) return;
   const ParticleStore& p = s.p;
-  // The intact bonds are moved down in place (slot kept <= k: every slot is read before it is
-  // written), so a break step allocates no new store: at thesis scale the bond list is tens of MB,
-  // and fresh pages for it on every break step cost as much as the bond stage.
-  std::size_t kept = 0;
+  // The broken bonds are handled in place; those of which nothing holds any more leave the list
+  // at the end, column by column (a break step allocates nothing: at thesis scale the bond list
+  // is tens of MB, and fresh pages for it on every break step cost as much as the bond stage).
+  BondLosses losses;
   // The freed pairs (bonds of which nothing holds any more), in bond order (sorted by (a, b) like
   // the bond list they come from), made while the bond's slot is still intact. A touching one
   // keeps the contact's normal and shear force capped at the friction limit; the others start as
   // the search starts a new pair (no shear force, the current direction as the previous normal).
-  PairStore freed;
+  PairStore& freed = s.cache.freed_pairs;
   std::size_t nfreed = 0;
   const ContactMaterial& m = s.settings.contact;
   const BondMaterial& bm = q.material;
   const bool with_beam = bm.contact_strength == 0;
   for (std::size_t k = 0; k < q.n; ++k) {
-    if (q.broken[k] == 0) {
-      if (kept != k) q.copy_from(q, k, kept);
-      ++kept;
-      continue;
-    }
+    if (q.broken[k] == 0) continue;
     const auto parts = static_cast<int>(q.broken[k]);
     const int holds = static_cast<int>(q.holds[k]) & ~parts;
     const auto a = q.a[k], b = q.b[k];
@@ -146,6 +142,8 @@ void process_breaks(State& s) {
       const double contact_part = with_beam ? kernels::spring_energy(q, k, m) - spring_kept : 0.0;
       book(kernels::beam_energy(q, k, bm) + contact_part);
       kernels::unload_beam(q, k);
+      losses.beam_ends.push_back(a);
+      losses.beam_ends.push_back(b);
     }
     if (contact_goes && !with_beam) {
       const double rb = q.beam_radius[k], A = kernels::kPi * rb * rb;
@@ -164,10 +162,12 @@ void process_breaks(State& s) {
     q.broken[k] = 0;
     if (holds != 0) {  // the other part holds: the bond stays, with what is left of it
       q.holds[k] = holds;
-      if (kept != k) q.copy_from(q, k, kept);
-      ++kept;
+      losses.partial_left = true;
       continue;
     }
+    losses.gone.push_back(k);
+    losses.gone_ends.push_back(a);
+    losses.gone_ends.push_back(b);
     ++s.p.bonds_broken[a];
     ++s.p.bonds_broken[b];
     // The pair enters the contact list now (the search never listed it while it was bonded),
@@ -192,8 +192,8 @@ void process_breaks(State& s) {
     }
   }
   freed.resize(nfreed);
-  q.resize(kept);
-  refresh_bond_topology(s);
+  q.remove(losses.gone);
+  refresh_bond_topology_after_breaks(s, losses);
   // Into the pair list without a rebuild: a fracture run breaks bonds on most of its steps, and a
   // rebuild for each would rebuild the list (and reorder the particles) nearly every step.
   insert_pairs(s, freed);

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include "asperity/world.hpp"
@@ -20,14 +21,23 @@
 
 namespace asperity::detail {
 
+// An empty slot at the end of a particle's run of bonded partners (Caches::partners): above every
+// index, so the run stays sorted for the search's binary search.
+inline constexpr std::int32_t kNoPartner = std::numeric_limits<std::int32_t>::max();
+
 // Derived from the world's data and kept between steps because computing them every step costs:
 // each says when it is valid, and what the API changes reaches them through changed() (below).
 struct Caches {
   // Bonded partners per particle (CSR, sorted): the neighbour search leaves bonded pairs out.
   // With the bond incidence (the gather's CSR of the bonds) and the bonded particles, redone by
   // refresh_bond_topology whenever the bond list changes.
+  // A break takes a partner out of its particle's run, which stays sorted and ends in
+  // kNoPartner slots (refresh_bond_topology_after_breaks) until the next full refresh.
   Incidence bond_incidence;
   std::vector<std::int32_t> partner_start, partners;
+  // Per particle, its bonds whose parallel bond holds (frozen ones too): kept only while the
+  // rotation lock counts beams alone (WorldSettings::rotation_lock_beams).
+  std::vector<std::int32_t> beam_count;
   // The particles holding a bond the step computes (frozen ones aside): the bond stage checks
   // their angular velocities each step (stages/bonds.cpp, bond_stage).
   std::vector<std::int32_t> bonded_particles;
@@ -55,6 +65,9 @@ struct Caches {
   // (stages/pairs.cpp). Kept here: a neighbour build replaces the pair store.
   bool pair_records_sparse = false;
   ServoContacts servo;  // the contacts between bodies, for the servo (store/groups.hpp)
+  // Stores a break step fills and swaps in place of allocating (process_breaks, insert_pairs): the
+  // pairs its broken bonds free, and the pair list's other half, which the merge writes into.
+  PairStore freed_pairs, spare_pairs;
   // Idle group members (see Group::busy), per particle index; valid while idle_valid (the split
   // is redone at every neighbour build and after the API changes motions or applied forces).
   std::vector<std::uint8_t> idle;

@@ -543,20 +543,51 @@ double start_pair(PairStore& q, std::size_t k, const ParticleStore& p) {
 void insert_pairs(State& s, const PairStore& add) {
   if (add.n == 0) return;
   const PairStore& old = s.pairs;
-  PairStore merged;
+  // The merged list is written into the spare store (its pages already mapped: a fracture run
+  // merges on most of its steps) and swapped in; the old list becomes the spare.
+  PairStore& merged = s.cache.spare_pairs;
   merged.resize(old.n + add.n);
-  std::size_t i = 0, j = 0;
-  for (std::size_t k = 0; k < merged.n; ++k) {
-    const bool from_old = j >= add.n || (i < old.n && (old.a[i] != add.a[j] ? old.a[i] < add.a[j]
-                                                                            : old.b[i] < add.b[j]));
-    const PairStore& src = from_old ? old : add;
-    const std::size_t o = from_old ? i++ : j++;
-    merged.a[k] = src.a[o];
-    merged.b[k] = src.b[o];
-    merged.copy_history(src, o, k);
+  // Where each added pair goes: before the first old pair above it in (a, b) order.
+  std::vector<std::size_t> at(add.n);
+  {
+    std::size_t i = 0;
+    for (std::size_t j = 0; j < add.n; ++j) {
+      while (i < old.n && (old.a[i] != add.a[j] ? old.a[i] < add.a[j] : old.b[i] < add.b[j])) ++i;
+      at[j] = i;
+    }
+  }
+  // Column by column: the old pairs in runs between the added ones.
+  auto merge = [&](auto& to, const auto& from_old, const auto& from_add) {
+    std::size_t o = 0, k = 0;
+    for (std::size_t j = 0; j < add.n; ++j) {
+      std::copy(from_old.begin() + std::ptrdiff_t(o), from_old.begin() + std::ptrdiff_t(at[j]), to.begin() + std::ptrdiff_t(k));
+      k += at[j] - o;
+      o = at[j];
+      to[k++] = from_add[j];
+    }
+    std::copy(from_old.begin() + std::ptrdiff_t(o), from_old.begin() + std::ptrdiff_t(old.n), to.begin() + std::ptrdiff_t(k));
+  };
+  merge(merged.a, old.a, add.a);
+  merge(merged.b, old.b, add.b);
+  PairStore::history_columns([&](const ColumnInfo&, auto& to, const auto& o, const auto& a) { merge(to, o, a); },
+                             merged, old, add);
+  // The last step's normal forces and overlaps, wherever the old list holds them.
+  if (old.outputs_in_records) {
+    std::size_t o = 0, k = 0;
+    for (std::size_t j = 0; j <= add.n; ++j) {
+      for (const std::size_t end = j < add.n ? at[j] : old.n; o < end; ++o, ++k) {
+        merged.fn[k] = old.out[kPairRecord * o + 7];
+        merged.overlap[k] = old.out[kPairRecord * o + 3];
+      }
+      if (j < add.n) {
+        merged.fn[k] = add.normal_force(j);
+        merged.overlap[k] = add.overlap_at(j);
+        ++k;
+      }
+    }
   }
   merged.fill_padding(s.p.null_a(), s.p.null_b());
-  s.pairs = std::move(merged);
+  std::swap(s.pairs, merged);
   build_incidence(s.p.n, s.pairs.a.data(), s.pairs.b.data(), s.pairs.n, s.incidence);
   s.cache.servo.pairs_at = ~std::uint64_t(0);  // the servo's list holds pair indices
   s.cache.idle_valid = false;                  // a member may have a pair now

@@ -4,10 +4,26 @@
 // locks (model.md 2). Rebuilt whenever the bonds or the particles' order change: after an
 // install, a break, a reorder, a load.
 #pragma once
+#include <vector>
+
 #include "state.hpp"
 
 namespace asperity::detail {
 
 void refresh_bond_topology(State& s);
+
+// What a break step did to the bond list (process_breaks): the bonds of which nothing holds any
+// more, taken out (their indices before, ascending, and their ends a, b in pairs), and the ends
+// of the bonds whose parallel bond broke.
+struct BondLosses {
+  std::vector<std::size_t> gone;
+  std::vector<std::int64_t> gone_ends, beam_ends;
+  bool partial_left = false;  // some bond lost one part and keeps the other
+};
+// The topology brought up to date after such a step in what the step changed (the incidence
+// again when bonds left, the partners, locks and counts of their particles): the same as
+// refresh_bond_topology, without the passes over every particle and bond that a step with a
+// few breaks in a large specimen would otherwise pay.
+void refresh_bond_topology_after_breaks(State& s, const BondLosses& losses);
 
 }  // namespace asperity::detail

@@ -96,6 +96,15 @@ struct BondStore {
     b[k] = from.b[o];
     columns([&](const ColumnInfo&, auto& to, const auto& src) { to[k] = src[o]; }, *this, from);
   }
+  // The bonds `rows` (ascending) taken out, the others kept in order (the padding is left to
+  // fill_padding).
+  void remove(const std::vector<std::size_t>& rows) {
+    if (rows.empty()) return;
+    remove_slots(a, rows, n);
+    remove_slots(b, rows, n);
+    columns([&](const ColumnInfo&, auto& c) { remove_slots(c, rows, n); }, *this);
+    resize(n - rows.size());
+  }
   // Bond k seen from the other side (a and b swap roles, as a renumbering may ask).
   void swap_roles(std::size_t k) {
     columns([&](const ColumnInfo& c, auto& col) { if (c.flips) col[k] = -col[k]; }, *this);

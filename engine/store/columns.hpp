@@ -39,6 +39,18 @@ void pad_column(V& col, std::size_t from, std::size_t to, double pad) {
             static_cast<typename V::value_type>(pad));
 }
 
+// Slots `rows` (ascending, all below n) taken out of the first n of a column, the others moved
+// down in order: segment by segment, so a few rows out of a long column cost one pass of copies.
+template <class V>
+void remove_slots(V& col, const std::vector<std::size_t>& rows, std::size_t n) {
+  if (rows.empty()) return;
+  auto to = col.begin() + std::ptrdiff_t(rows[0]);
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    const std::size_t from = rows[r] + 1, end = r + 1 < rows.size() ? rows[r + 1] : n;
+    to = std::copy(col.begin() + std::ptrdiff_t(from), col.begin() + std::ptrdiff_t(end), to);
+  }
+}
+
 // New slot i holds old slot order[i]; the slots past `order` keep theirs.
 template <class V>
 void permute_column(V& col, const std::vector<std::int32_t>& order) {

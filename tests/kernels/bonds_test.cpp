@@ -13,6 +13,7 @@
 #include "core/aligned.hpp"
 #include "kernels/kernels.hpp"
 #include "scenes.hpp"
+#include "neighbor/topology.hpp"
 #include "state.hpp"
 
 using namespace asperity;
@@ -961,6 +962,68 @@ TEST(Bonds, BondedBlockIsDeterministicAcrossThreadsAndSurvivesReorders) {
     if (stress_free) {
       EXPECT_GT(one.second, 0u) << "bonds must break: their contacts keep rest overlaps";
     }
+  }
+}
+
+// A break step brings the topology up to date in what it changed only
+// (refresh_bond_topology_after_breaks): after steps of breaks of every kind (bonds gone whole,
+// contact bonds and beams apart, particles freed, by each lock rule) it holds what a full
+// refresh builds from the bond list, the emptied slots of the partners' runs aside.
+TEST(Bonds, BreakStepsLeaveTheTopologyAFullRefreshBuilds) {
+  struct Topology {
+    std::vector<std::int32_t> incidence_start, partners, bonded_particles, beam_count;
+    std::vector<std::int64_t> incidence_entry;
+    std::vector<std::uint8_t> locked;
+    bool partial, moments_zero, any_rotating;
+    bool operator==(const Topology&) const = default;
+  };
+  auto topology = [](const detail::State& s) {
+    const detail::Caches& c = s.cache;
+    Topology t{c.bond_incidence.start, {}, c.bonded_particles, c.beam_count, c.bond_incidence.entry,
+               std::vector<std::uint8_t>(s.p.rotation_locked.begin(), s.p.rotation_locked.begin() + std::ptrdiff_t(s.p.n)),
+               c.bonds_partial, c.bond_moments_zero, s.any_rotating};
+    for (const std::int32_t o : c.partners)
+      if (o != detail::kNoPartner) t.partners.push_back(o);
+    return t;
+  };
+  struct Rule { int lock_bonds; bool beams; double c; };
+  for (const Rule rule : {Rule{1, false, 1.0}, Rule{3, false, 0.5}, Rule{1, true, 1.0}, Rule{2, true, 0.0}}) {
+    SCOPED_TRACE(testing::Message() << "rotation_lock_bonds " << rule.lock_bonds << ", beams only "
+                                    << rule.beams << ", contact_strength " << rule.c);
+    WorldSettings ws;
+    ws.dt = 5e-4;
+    ws.rotation_lock_bonds = rule.lock_bonds;
+    ws.rotation_lock_beams = rule.beams;
+    World w = test::random_box(600, ws);
+    w.cycle(3000);
+    BondMaterial bm;
+    bm.tensile_strength = 0.05;
+    bm.contact_strength = rule.c;
+    const std::size_t installed = w.install_bonds(bm, 2e-5);
+    // Shaken apart: a random velocity each, well above what the bonds hold.
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (std::size_t id = 0; id < w.particle_count(); ++id)
+      w.set_velocity(std::int64_t(id), {2e-3 * u(rng), 2e-3 * u(rng), 2e-3 * u(rng)});
+    detail::State& s = w.state();
+    bool some_partial = false, some_freed = false;
+    // Compared after every fifth step that broke bonds (the breaks of the steps between pile up
+    // in the runs of partners); only a step with breaks finds the kernel's flags again.
+    for (int step = 0, breaking = 0; step < 400; ++step) {
+      const std::size_t before = w.break_events().size();
+      w.cycle(1);
+      if (w.break_events().size() == before || ++breaking % 5 != 0) continue;
+      const Topology after_breaks = topology(s);
+      detail::refresh_bond_topology(s);
+      ASSERT_EQ(after_breaks, topology(s)) << "after step " << w.step_count();
+      some_partial = some_partial || s.cache.bonds_partial;
+      some_freed = some_freed || s.any_rotating;
+    }
+    const std::size_t breaks = w.break_events().size();
+    EXPECT_GT(breaks, installed / 4) << "most steps break bonds";
+    EXPECT_LT(w.bonds().size(), installed) << "bonds went whole";
+    EXPECT_EQ(some_partial, rule.c != 0.0) << "contact bonds and beams break apart, unless together";
+    EXPECT_TRUE(some_freed) << "damage frees particles";
   }
 }
 
