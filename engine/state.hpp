@@ -65,8 +65,9 @@ struct Caches {
   // (stages/pairs.cpp). Kept here: a neighbour build replaces the pair store.
   bool pair_records_sparse = false;
   ServoContacts servo;  // the contacts between bodies, for the servo (store/groups.hpp)
-  // Stores a break step fills and swaps in place of allocating (process_breaks, insert_pairs): the
-  // pairs its broken bonds free, and the pair list's other half, which the merge writes into.
+  // Stores filled and swapped in place of allocating: the pairs a break step's broken bonds free
+  // (process_breaks), and the pair list's other half, which a neighbour build or the merge of the
+  // freed pairs writes into (build_pairs, insert_pairs).
   PairStore freed_pairs, spare_pairs;
   // Idle group members (see Group::busy), per particle index; valid while idle_valid (the split
   // is redone at every neighbour build and after the API changes motions or applied forces).

@@ -337,7 +337,9 @@ void build_pairs(State& s, const CellGrid& g) {
   std::partial_sum(count.begin(), count.end(), count.begin());
   const std::size_t total = std::size_t(count[n]);
 
-  PairStore fresh;
+  // Written into the spare store (its pages mapped and zeroed once: a fracture run rebuilds every
+  // hundred steps or so, and fresh pages for the list cost as much as its search) and swapped in.
+  PairStore& fresh = s.cache.spare_pairs;
   fresh.resize(total);
 #pragma omp parallel for schedule(dynamic, 256) num_threads(thread_count(s))
   for (std::size_t i = 0; i < n; ++i) {
@@ -384,7 +386,7 @@ void build_pairs(State& s, const CellGrid& g) {
     ih.resize(0);
   }
   fresh.fill_padding(p.null_a(), p.null_b());
-  s.pairs = std::move(fresh);
+  std::swap(s.pairs, fresh);
   build_incidence(n, s.pairs.a.data(), s.pairs.b.data(), total, s.incidence);
 }
 

@@ -94,6 +94,7 @@ struct PairStore {
     out.resize(kPairRecord * padded);
     touched.assign(padded / kTouchStage + 1, 1);
     live.assign(padded, 1);
+    live_written = false;
     live_current = false;
     outputs_in_records = false;
   }
