@@ -69,6 +69,7 @@ struct Caches {
   // (process_breaks), and the pair list's other half, which a neighbour build or the merge of the
   // freed pairs writes into (build_pairs, insert_pairs).
   PairStore freed_pairs, spare_pairs;
+  std::vector<std::vector<std::int32_t>> found_pairs;  // a neighbour build's, per chunk of particles
   // Idle group members (see Group::busy), per particle index; valid while idle_valid (the split
   // is redone at every neighbour build and after the API changes motions or applied forces).
   std::vector<std::uint8_t> idle;

@@ -327,12 +327,23 @@ void neighbours_of(const State& s, const CellGrid& g, std::size_t i, Out&& out) 
 
 void build_pairs(State& s, const CellGrid& g) {
   const std::size_t n = s.p.n;
+  // One search per particle, into lists per chunk of kChunk particles (the unit the threads share
+  // out), then copied into the store at their offsets: the list is the same for any thread count.
+  constexpr std::size_t kChunk = 256;
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<std::vector<std::int32_t>>& found = s.cache.found_pairs;
+  found.resize(chunks);
   std::vector<std::int64_t> count(n + 1, 0);
-#pragma omp parallel for schedule(dynamic, 256) num_threads(thread_count(s))
-  for (std::size_t i = 0; i < n; ++i) {
-    std::int64_t c = 0;
-    neighbours_of(s, g, i, [&](std::int32_t) { ++c; });
-    count[i + 1] = c;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(thread_count(s))
+  for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
+    std::vector<std::int32_t>& list = found[chunk];
+    list.clear();
+    for (std::size_t i = chunk * kChunk; i < std::min(n, (chunk + 1) * kChunk); ++i) {
+      const std::size_t first = list.size();
+      neighbours_of(s, g, i, [&](std::int32_t o) { list.push_back(o); });
+      std::sort(list.begin() + std::ptrdiff_t(first), list.end());
+      count[i + 1] = std::int64_t(list.size() - first);
+    }
   }
   std::partial_sum(count.begin(), count.end(), count.begin());
   const std::size_t total = std::size_t(count[n]);
@@ -341,29 +352,31 @@ void build_pairs(State& s, const CellGrid& g) {
   // hundred steps or so, and fresh pages for the list cost as much as its search) and swapped in.
   PairStore& fresh = s.cache.spare_pairs;
   fresh.resize(total);
-#pragma omp parallel for schedule(dynamic, 256) num_threads(thread_count(s))
-  for (std::size_t i = 0; i < n; ++i) {
-    std::size_t at = std::size_t(count[i]);
-    neighbours_of(s, g, i, [&](std::int32_t o) { fresh.b[at++] = o; });
-    std::sort(fresh.b.begin() + count[i], fresh.b.begin() + count[i + 1]);
-    for (std::int64_t k = count[i]; k < count[i + 1]; ++k) fresh.a[k] = std::int64_t(i);
-  }
-
-  // Carry history: both lists sorted by (a, b).
+  // Carry history: both lists sorted by (a, b), each chunk's pairs merged with the old list from
+  // where its first particle's pairs begin there.
   const PairStore& old = s.pairs;
-  std::size_t o = 0;
   const ParticleStore& p = s.p;
-  for (std::size_t k = 0; k < total; ++k) {
-    const std::int64_t a = fresh.a[k], b = fresh.b[k];
-    while (o < old.n && (old.a[o] < a || (old.a[o] == a && old.b[o] < b))) ++o;
-    if (o < old.n && old.a[o] == a && old.b[o] == b) {
-      fresh.copy_history(old, o, k);
-      // The overlap as it is now (radii may have changed since the last step): the time-step
-      // estimate made right after this rebuild counts the contacts of the current geometry.
-      const double dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];
-      fresh.overlap[k] = p.radius[a] + p.radius[b] - std::sqrt(dx * dx + dy * dy + dz * dz);
-    } else {
-      fresh.overlap[k] = p.radius[a] + p.radius[b] - start_pair(fresh, k, p);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(thread_count(s))
+  for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
+    const std::size_t lo = chunk * kChunk, hi = std::min(n, (chunk + 1) * kChunk);
+    const std::size_t begin = std::size_t(count[lo]), end = std::size_t(count[hi]);
+    std::copy(found[chunk].begin(), found[chunk].end(), fresh.b.begin() + std::ptrdiff_t(begin));
+    for (std::size_t i = lo; i < hi; ++i)
+      std::fill(fresh.a.begin() + count[i], fresh.a.begin() + count[i + 1], std::int64_t(i));
+    std::size_t o = std::size_t(std::lower_bound(old.a.begin(), old.a.begin() + std::ptrdiff_t(old.n),
+                                                  std::int64_t(lo)) - old.a.begin());
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::int64_t a = fresh.a[k], b = fresh.b[k];
+      while (o < old.n && (old.a[o] < a || (old.a[o] == a && old.b[o] < b))) ++o;
+      if (o < old.n && old.a[o] == a && old.b[o] == b) {
+        fresh.copy_history(old, o, k);
+        // The overlap as it is now (radii may have changed since the last step): the time-step
+        // estimate made right after this rebuild counts the contacts of the current geometry.
+        const double dx = p.x[b] - p.x[a], dy = p.y[b] - p.y[a], dz = p.z[b] - p.z[a];
+        fresh.overlap[k] = p.radius[a] + p.radius[b] - std::sqrt(dx * dx + dy * dy + dz * dz);
+      } else {
+        fresh.overlap[k] = p.radius[a] + p.radius[b] - start_pair(fresh, k, p);
+      }
     }
   }
   // Contacts left behind by broken bonds take over their capped shear force.
