@@ -95,7 +95,7 @@ void process_breaks(State& s) {
   if (any == 0) return;
   const ParticleStore& p = s.p;
   // The broken bonds are handled in place; those of which nothing holds any more leave the list
-  // at the end, column by column (a break step allocates nothing: at thesis scale the bond list
+  // at the end, column by column (a break step allocates no store: at thesis scale the bond list
   // is tens of MB, and fresh pages for it on every break step cost as much as the bond stage).
   BondLosses losses;
   // The freed pairs (bonds of which nothing holds any more), in bond order (sorted by (a, b) like
