@@ -584,9 +584,13 @@ void insert_pairs(State& s, const PairStore& add) {
   };
   merge(merged.a, old.a, add.a);
   merge(merged.b, old.b, add.b);
-  PairStore::history_columns([&](const ColumnInfo&, auto& to, const auto& o, const auto& a) { merge(to, o, a); },
-                             merged, old, add);
-  // The last step's normal forces and overlaps, wherever the old list holds them.
+  // The last step's normal forces and overlaps: from the columns, or, where the old list holds
+  // them in its records (the columns stale), from there below.
+  PairStore::history_columns(
+      [&](const ColumnInfo&, auto& to, const auto& o, const auto& a) {
+        if (!old.outputs_in_records || (&to != &merged.fn && &to != &merged.overlap)) merge(to, o, a);
+      },
+      merged, old, add);
   if (old.outputs_in_records) {
     std::size_t o = 0, k = 0;
     for (std::size_t j = 0; j <= add.n; ++j) {
