@@ -386,11 +386,21 @@ local function write_tables(rows)
   write_atomic(DIR .. "/study.json", asperity.json({columns = cols, runs = rows}))
 end
 
+-- The runner's own wall time, added up over its invocations (the report's "Run time").
+local ELAPSED = DIR .. "/.study/elapsed.json"
+local function read_elapsed()
+  if not exists(ELAPSED) then return nil end
+  local ok, e = pcall(json.read, ELAPSED)
+  return ok and type(e) == "table" and type(e.seconds) == "number" and e or nil
+end
+
 local function finish(rows)
   local failed = 0
   for _, row in ipairs(rows) do if row.status == "failed" then failed = failed + 1 end end
   if P.report then
-    local ok, err = pcall(function() require("study_report").write{dir = DIR, rows = rows, log = log} end)
+    local ok, err = pcall(function()
+      require("study_report").write{dir = DIR, rows = rows, log = log, elapsed = read_elapsed()}
+    end)
     if not ok then log("report not complete: %s", tostring(err)) end
   end
   return failed
@@ -563,6 +573,14 @@ log("%d runs in %s: %d finished before, %d failed before%s, %d to run; %d jobs x
     todo, jobs, threads, cores)
 write_tables(gather(runs))
 
+-- This invocation's time joins the earlier ones' whenever a run ends and when the runner stops.
+local elapsed_before = read_elapsed() or {seconds = 0, invocations = 0}
+local function record_elapsed()
+  if todo == 0 then return end
+  write_atomic(ELAPSED, asperity.json{seconds = elapsed_before.seconds + (asperity.wall_time() - t0),
+                                      invocations = elapsed_before.invocations + 1, jobs = jobs, threads = threads})
+end
+
 -- Wall time per model, for the estimates (packing runs separately: they include the packing).
 local times = {}
 local function estimate(run, packs)
@@ -729,6 +747,7 @@ local function run_all()
         log("INTERRUPTED %s after %s (stopped by a signal; the next run of the study resumes it)",
             name, clock(seconds))
       end
+      record_elapsed()
       write_tables(gather(runs))
     end
   end
@@ -742,12 +761,14 @@ if not ok then
     table.sort(names)
     log("interrupted: %s left part-way (resumed by the same command)",
         #names > 0 and table.concat(names, ", ") or "no run")
+    record_elapsed()
     write_tables(gather(runs))
     os.exit(130)
   end
   error(err, 0)
 end
 
+record_elapsed()
 local rows = gather(runs)
 write_tables(rows)
 finish(rows)

@@ -272,6 +272,17 @@ end
 --   local P = require("params").defaults{n = 400, out = "out/demo"}
 function M.defaults(defaults, given)
   given = given or params or {}
+  if defaults.help == nil and (given.help == true or given.help == "true") then
+    -- --help: the parameters and their defaults, then stop (the script has nothing to run).
+    local names = {}
+    for name in pairs(defaults) do names[#names + 1] = name end
+    table.sort(names)
+    local lines = {"parameters (key=value) and their defaults; the script's first lines say what they mean:"}
+    for _, name in ipairs(names) do lines[#lines + 1] = ("  %s=%s"):format(name, tostring(defaults[name])) end
+    io.write(table.concat(lines, "\n"), "\n")
+    io.stdout:flush()
+    os.exit(0)
+  end
   local out = {}
   for k, v in pairs(defaults) do out[k] = v end
   for k, v in pairs(given) do

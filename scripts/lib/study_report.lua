@@ -6,7 +6,8 @@
 --   plots/*.png              the comparison figures (gnuplot), reference.md's values beside ours
 --   events/                  the event statistics of the fracture runs (scenarios.md 8, lib/events.lua)
 --
---   require("study_report").write{dir = DIR, rows = rows, log = function(fmt, ...) end}
+--   require("study_report").write{dir = DIR, rows = rows, log = function(fmt, ...) end,
+--                                 elapsed = {seconds =, invocations =, jobs =, threads =} or nil}
 local fig = require("figures")
 local ev = require("events")
 
@@ -463,6 +464,67 @@ local function reference_markdown(rows)
   return table.concat(lines, "\n") .. "\n"
 end
 
+-- What the study cost: per model the runs' wall times (every attempt of a resumed run; a run that
+-- packed its specimen includes the packing), the packings, and the runner's elapsed time where the
+-- runner recorded it (out/.study/elapsed.json; not for a Slurm study, whose tasks run apart).
+local function duration(seconds)
+  if not finite(seconds) then return "n/a" end
+  seconds = math.floor(seconds + 0.5)
+  if seconds < 60 then return seconds .. " s" end
+  if seconds < 3600 then return ("%d min %02d s"):format(seconds // 60, seconds % 60) end
+  return ("%d h %02d min"):format(seconds // 3600, seconds % 3600 // 60)
+end
+function M.run_time(rows, elapsed)
+  local by, total, packed, pack_seconds = {}, 0, 0, 0
+  for _, r in ipairs(rows) do
+    if r.status == "finished" and finite(r.wall_seconds) then
+      local m = by[r.model] or {runs = 0, seconds = 0, longest = 0, resumed = 0, memory = 0}
+      by[r.model] = m
+      m.runs, m.seconds = m.runs + 1, m.seconds + r.wall_seconds
+      m.longest = math.max(m.longest, r.wall_seconds)
+      if finite(r.resumes) and r.resumes > 0 then m.resumed = m.resumed + 1 end
+      if finite(r.peak_memory_bytes) then m.memory = math.max(m.memory, r.peak_memory_bytes) end
+      total = total + r.wall_seconds
+      if (r.specimen_packed == true or r.specimen_packed == "true") and finite(r.specimen_seconds) then
+        packed, pack_seconds = packed + 1, pack_seconds + r.specimen_seconds
+      end
+    end
+  end
+  return {models = by, total_seconds = total, packings = packed, packing_seconds = pack_seconds, elapsed = elapsed}
+end
+local function run_time_markdown(rows, elapsed)
+  local T = M.run_time(rows, elapsed)
+  local lines = {"", "## Run time", ""}
+  if T.total_seconds == 0 then
+    lines[#lines + 1] = "No finished run records its wall time."
+    return table.concat(lines, "\n") .. "\n"
+  end
+  if elapsed and finite(elapsed.seconds) then
+    lines[#lines + 1] = ("The runner ran for **%s** in all (%d invocation%s, %d job%s of %d thread%s at a time; " ..
+                         "the pauses between invocations not counted)."):format(duration(elapsed.seconds), elapsed.invocations or 1,
+                         (elapsed.invocations or 1) == 1 and "" or "s", elapsed.jobs or 0, elapsed.jobs == 1 and "" or "s",
+                         elapsed.threads or 0, elapsed.threads == 1 and "" or "s")
+  else
+    lines[#lines + 1] = "The runner's elapsed time is not recorded here (a Slurm study's tasks run apart); the runs' own times follow."
+  end
+  lines[#lines + 1] = ""
+  lines[#lines + 1] = ("The runs' wall times add up to %s (a resumed run counts every attempt); %d specimen%s packed, %s of it " ..
+                       "(inside the times of the runs that packed them)."):format(duration(T.total_seconds), T.packings,
+                       T.packings == 1 and " was" or "s were", duration(T.packing_seconds))
+  lines[#lines + 1] = ""
+  lines[#lines + 1] = "| model | runs | wall time in sum | mean per run | longest | resumed | peak memory |"
+  lines[#lines + 1] = "|---|---|---|---|---|---|---|"
+  for _, model in ipairs(MODELS) do
+    local m = T.models[model]
+    if m then
+      lines[#lines + 1] = ("| %s | %d | %s | %s | %s | %d | %s |"):format(model, m.runs, duration(m.seconds),
+        duration(m.seconds / m.runs), duration(m.longest), m.resumed,
+        m.memory > 0 and ("%.0f MB"):format(m.memory / 1e6) or "n/a")
+    end
+  end
+  return table.concat(lines, "\n") .. "\n"
+end
+
 -- The figures inline (Markdown images, paths relative to the study folder), so that trends.md
 -- reads as one page on a code host.
 local SECTIONS = {{"strength", "Peak and residual against the surface statistics"},
@@ -822,7 +884,8 @@ function M.write(o)
   local n = #figures
   local e, pooled = events(dir, rows, log)
   for _, f in ipairs(pooled or {}) do figures[#figures + 1] = f end
-  write_atomic(dir .. "/trends.md", trends_markdown(T, rows) .. reference_markdown(rows) .. figures_markdown(figures))
+  write_atomic(dir .. "/trends.md", trends_markdown(T, rows) .. reference_markdown(rows) .. run_time_markdown(rows, o.elapsed)
+                                    .. figures_markdown(figures))
   local shown = 0
   for _, t in ipairs(T) do if t.verdict == "shown" then shown = shown + 1 end end
   log("report: trends.md (%d of %d behaviours shown), %d plots in plots/, events of %d fracture runs%s",

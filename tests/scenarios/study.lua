@@ -67,6 +67,13 @@ assert(trends.elastic_above_rigid_peak.comparisons == 2, "elastic against rigid:
 assert(trends.fracture_between.verdict == "untestable", "no fracture run: untestable")
 local md = read(dir .. "/trends.md")
 assert(md:find("| peak shear stress grows as H falls | ", 1, true) and md:find("untestable", 1, true), "trends.md")
+-- The runner's time is recorded, and the report gives it with the runs' times per model.
+local elapsed = json.read(dir .. "/.study/elapsed.json")
+assert(elapsed.invocations == 1 and elapsed.seconds > 0 and elapsed.jobs >= 1 and elapsed.threads == 1,
+       "elapsed.json: " .. asperity.json(elapsed))
+assert(md:find("## Run time", 1, true) and md:find("The runner ran for **", 1, true)
+       and md:find("\n| rigid | 2 | ", 1, true) and md:find("\n| elastic | 2 | ", 1, true)
+       and md:find("2 specimens were packed", 1, true), "the run time section:\n" .. md)
 -- The fracture study, for the event statistics (events_every=100 by default for fracture runs).
 local fdir = out .. "/fracture"
 status, log = run(("surfaces=S1 stresses=14 directions=x models=fracture jobs=1 threads=1 size=0.008 " ..
@@ -99,6 +106,7 @@ assert(json.read(one .. "/S1_14_x_rigid_s1/summary.json").parameters.threads == 
 -- A rerun does nothing (everything finished) and collect=true rebuilds the same rows.
 status, log = run(args, out .. "/again.log")
 assert(status == 0 and log:find("4 finished before", 1, true) and not log:find("started", 1, true), "rerun:\n" .. log)
+assert(json.read(dir .. "/.study/elapsed.json").invocations == 1, "a runner that ran nothing adds no invocation")
 os.remove(dir .. "/study.csv")
 status, log = run(("collect=true out='%s'"):format(dir), out .. "/collect.log")
 assert(status == 0 and read(dir .. "/study.csv") == csv, "collect=true rebuilds study.csv:\n" .. log)

@@ -25,6 +25,10 @@ for _, seed in ipairs{1, 2} do
           max_dilatancy_mm = ({rigid = 1.0, elastic = 0.9, fracture = 0.5})[model] * (surface == "S5" and 1.4 or 1) * 14 / stress,
           broken_bonds = model == "fracture" and (surface == "S5" and 300 or 100) or 0,
           contact_decay_exponent = -0.5, energy_shares_friction = 0.8, energy_shares_damping = 0.1,
+          -- the rigid run of each surface and seed packs its specimen (50 s of its time)
+          wall_seconds = ({rigid = 60, elastic = 300, fracture = 900})[model], resumes = model == "fracture" and seed or 0,
+          specimen_packed = model == "rigid", specimen_seconds = model == "rigid" and 50 or 0,
+          peak_memory_bytes = ({rigid = 3e8, elastic = 2e8, fracture = 2.5e8})[model] * (surface == "S5" and 1.2 or 1),
         }
       end
     end
@@ -150,8 +154,14 @@ for name, c in pairs(curves) do
   end
   f:close()
 end
-report.write{dir = out, rows = rows}
+report.write{dir = out, rows = rows, elapsed = {seconds = 4000, invocations = 2, jobs = 2, threads = 1}}
 local md = io.open(out .. "/trends.md"):read("a")
+-- Run time: 8 runs a model (2 surfaces, 2 stresses, 2 seeds); 8 specimens packed by the rigid runs.
+assert(md:find("The runner ran for **1 h 06 min** in all (2 invocations, 2 jobs of 1 thread at a time", 1, true), md)
+assert(md:find("The runs' wall times add up to 2 h 48 min", 1, true), md)          -- 8 x (60 + 300 + 900) s
+assert(md:find("8 specimens were packed, 6 min 40 s of it", 1, true), md)
+assert(md:find("| rigid | 8 | 8 min 00 s | 1 min 00 s | 1 min 00 s | 0 | 360 MB |", 1, true), md)
+assert(md:find("| fracture | 8 | 2 h 00 min | 15 min 00 s | 15 min 00 s | 8 | 300 MB |", 1, true), md)
 assert(md:find("| peak shear stress grows as H falls | shown | 12 / 12 | mean relative change -33.3 %", 1, true), md)
 assert(md:find("12 cases ran with two or more seeds", 1, true), "the scatter over seeds is reported:\n" .. md)
 assert(md:find("- peak_shear_stress_mpa: 6.7 %", 1, true), "SD / mean of p and 1.1 p is 6.7 %:\n" .. md)
