@@ -505,7 +505,8 @@ local function run_time_markdown(rows, elapsed)
                          (elapsed.invocations or 1) == 1 and "" or "s", elapsed.jobs or 0, elapsed.jobs == 1 and "" or "s",
                          elapsed.threads or 0, elapsed.threads == 1 and "" or "s")
   else
-    lines[#lines + 1] = "The runner's elapsed time is not recorded here (a Slurm study's tasks run apart); the runs' own times follow."
+    lines[#lines + 1] = "The runner's elapsed time is not recorded for this folder (a Slurm study's tasks run apart; a folder " ..
+                         "from before the runner recorded it); the runs' own times follow."
   end
   lines[#lines + 1] = ""
   lines[#lines + 1] = ("The runs' wall times add up to %s (a resumed run counts every attempt); %d specimen%s packed, %s of it " ..
