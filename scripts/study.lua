@@ -581,8 +581,19 @@ local function record_elapsed()
                                       invocations = elapsed_before.invocations + 1, jobs = jobs, threads = threads})
 end
 
--- Wall time per model, for the estimates (packing runs separately: they include the packing).
+-- Wall time per model, for the estimates (packing runs separately: they include the packing),
+-- from the start with the runs finished before (their summaries' wall time, every attempt).
 local times = {}
+for _, run in ipairs(runs) do
+  if state_of(run.name) == "finished" then
+    local ok, s = pcall(json.read, DIR .. "/" .. run.name .. "/summary.json")
+    if ok and type(s) == "table" and type(s.wall_seconds) == "number" then
+      local key = run.model .. (s.specimen_packed == true and "+pack" or "")
+      times[key] = times[key] or {}
+      table.insert(times[key], s.wall_seconds)
+    end
+  end
+end
 local function estimate(run, packs)
   local function mean(key)
     local t = times[key]

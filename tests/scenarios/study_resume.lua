@@ -72,6 +72,15 @@ for _, name in ipairs(before) do
   assert(read(dir .. "/" .. name .. "/summary.json") == kept[name], name .. "'s result was rewritten")
 end
 assert(log:find("started " .. part .. " (again: it was interrupted)", 1, true), part .. " must start again:\n" .. log)
+-- A model with a run finished before has an estimate from the start (that run's wall time).
+local model_before = {}
+for _, name in ipairs(before) do model_before[name:match("_(%a+)_s1$")] = true end
+for line in log:gmatch("[^\n]+") do
+  local model = line:match("%] started S1_14_%a_(%a+)_s1")
+  if model and model_before[model] then
+    assert(line:find("expected to end at", 1, true), "a " .. model .. " run finished before: an estimate at once:\n" .. log)
+  end
+end
 local after = check_results()
 assert(#after == #names, ("%d of %d runs finished after the resume"):format(#after, #names))
 for _, name in ipairs(names) do assert(not exists(dir .. "/" .. name .. ".part"), name .. ".part left behind") end
