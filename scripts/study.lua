@@ -538,13 +538,7 @@ end
 -- The runner -------------------------------------------------------------------------------------
 local my_pid = tonumber(capture("echo $PPID"))
 local t0 = asperity.wall_time()
-local function clock(seconds)
-  if seconds ~= seconds or seconds == math.huge then return "?" end
-  seconds = math.max(0, math.floor(seconds + 0.5))
-  if seconds < 60 then return seconds .. " s" end
-  if seconds < 3600 then return ("%d min %02d s"):format(seconds // 60, seconds % 60) end
-  return ("%d h %02d min"):format(seconds // 3600, seconds % 3600 // 60)
-end
+local clock = require("study_report").duration
 local function sleep(seconds)
   -- Through popen, not os.execute: system() ignores SIGINT in the caller, so a Ctrl-C during the
   -- wait would not reach this script.

@@ -467,9 +467,10 @@ end
 -- What the study cost: per model the runs' wall times (every attempt of a resumed run; a run that
 -- packed its specimen includes the packing), the packings, and the runner's elapsed time where the
 -- runner recorded it (out/.study/elapsed.json; not for a Slurm study, whose tasks run apart).
-local function duration(seconds)
-  if not finite(seconds) then return "n/a" end
-  seconds = math.floor(seconds + 0.5)
+-- A duration for people: "42 s", "3 min 07 s", "2 h 05 min" ("?" when not known).
+function M.duration(seconds)
+  if not finite(seconds) then return "?" end
+  seconds = math.max(0, math.floor(seconds + 0.5))
   if seconds < 60 then return seconds .. " s" end
   if seconds < 3600 then return ("%d min %02d s"):format(seconds // 60, seconds % 60) end
   return ("%d h %02d min"):format(seconds // 3600, seconds % 3600 // 60)
@@ -493,6 +494,7 @@ function M.run_time(rows, elapsed)
   return {models = by, total_seconds = total, packings = packed, packing_seconds = pack_seconds, elapsed = elapsed}
 end
 local function run_time_markdown(rows, elapsed)
+  local duration = M.duration
   local T = M.run_time(rows, elapsed)
   local lines = {"", "## Run time", ""}
   if T.total_seconds == 0 then
