@@ -475,7 +475,7 @@ function M.duration(seconds)
   if seconds < 3600 then return ("%d min %02d s"):format(seconds // 60, seconds % 60) end
   return ("%d h %02d min"):format(seconds // 3600, seconds % 3600 // 60)
 end
-function M.run_time(rows, elapsed)
+function M.run_time(rows)
   local by, total, packed, pack_seconds = {}, 0, 0, 0
   for _, r in ipairs(rows) do
     if r.status == "finished" and finite(r.wall_seconds) then
@@ -491,11 +491,11 @@ function M.run_time(rows, elapsed)
       end
     end
   end
-  return {models = by, total_seconds = total, packings = packed, packing_seconds = pack_seconds, elapsed = elapsed}
+  return {models = by, total_seconds = total, packings = packed, packing_seconds = pack_seconds}
 end
 local function run_time_markdown(rows, elapsed)
   local duration = M.duration
-  local T = M.run_time(rows, elapsed)
+  local T = M.run_time(rows)
   local lines = {"", "## Run time", ""}
   if T.total_seconds == 0 then
     lines[#lines + 1] = "No finished run records its wall time."
