@@ -400,6 +400,10 @@ void build_pairs(State& s, const CellGrid& g) {
   }
   fresh.fill_padding(p.null_a(), p.null_b());
   std::swap(s.pairs, fresh);
+  // The previous list is kept as the next spare only where bonds can break (a fracture run
+  // rebuilds and merges freed pairs every few dozen steps); elsewhere it is released: a second
+  // list for the whole run would be a second pair store of resident memory.
+  if (!(s.bonds.n > 0 && s.bonds.material.breakable)) fresh = PairStore();
   build_incidence(n, s.pairs.a.data(), s.pairs.b.data(), total, s.incidence);
 }
 
