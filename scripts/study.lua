@@ -420,7 +420,9 @@ end
 asperity.mkdir(DIR .. "/.study")
 write_atomic(DIR .. "/.study/run.sh", RUN_SH)
 -- The run names do not carry the settings every run shares, so a folder holds one study: a later
--- invocation with other settings would skip runs made differently and mix them in one table.
+-- invocation with other settings would skip runs made differently and mix them in one table. A
+-- setting not given follows the folder, so the command that started a study resumes it, even
+-- where a default changed since.
 do
   local settings = {size = P.size, joint = table.concat(extra, " "), normal_stiffness = P.normal_stiffness,
                     events_every = P.events_every, speedup = P.speedup}
@@ -432,7 +434,15 @@ do
     for _, k in ipairs{"size", "joint", "normal_stiffness", "events_every", "speedup"} do
       local was = before[k]
       if was == nil then was = made_without[k] end
-      if was ~= settings[k] then
+      if was ~= settings[k] and params[k] == nil then
+        log("%s=%s, as the study in %s was made (not given here)", k, tostring(was), DIR)
+        if k == "joint" then
+          extra = {}
+          for item in was:gmatch("%S+") do extra[#extra + 1] = item end
+        else
+          P[k] = was
+        end
+      elseif was ~= settings[k] then
         fail("%s holds a study made with %s=%s, not %s: give another out= (or the same %s)", DIR, k,
              tostring(was), tostring(settings[k]), k)
       end

@@ -114,6 +114,26 @@ assert(status == 0 and read(dir .. "/study.csv") == csv, "collect=true rebuilds 
 -- The folder holds one study: other shared settings are refused.
 status, log = run(args:gsub("pack_steps=50000", "pack_steps=60000"), out .. "/other.log")
 assert(status == 1 and log:find("holds a study made with joint=thickness=0.003 shear=1 pack_steps=50000", 1, true), log)
+-- A setting not given follows the folder: the command without joint= still writes the study's runs.
+status, log = run(("surfaces=S1 stresses=14 directions=x models=elastic out='%s' slurm='%s'"):format(dir, out .. "/same.sbatch"),
+                  out .. "/same.log")
+assert(status == 0 and log:find("joint=thickness=0.003 shear=1 pack_steps=50000, as the study in", 1, true)
+       and (read(out .. "/same.sbatch") or ""):find(" thickness=0.003 shear=1 pack_steps=50000 threads=", 1, true),
+       "joint= follows the folder:\n" .. log)
+-- A study made with speedup=2 resumes at 2 from a command without it, and is refused where another is given.
+local old = out .. "/fast_made"
+asperity.mkdir(old .. "/.study")
+local f = assert(io.open(old .. "/.study/settings.json", "w"))
+f:write('{"size": 0, "joint": "", "normal_stiffness": 0, "events_every": 100, "speedup": 2}\n')
+f:close()
+status, log = run(("surfaces=S1 stresses=14 directions=x models=elastic out='%s' slurm='%s'"):format(old, out .. "/old.sbatch"),
+                  out .. "/old.log")
+assert(status == 0 and log:find("speedup=2, as the study in", 1, true)
+       and (read(out .. "/old.sbatch") or ""):find(" model=elastic seed=1 speedup=2 threads=", 1, true),
+       "speedup follows the folder:\n" .. log .. tostring(read(out .. "/old.sbatch")))
+status, log = run(("surfaces=S1 stresses=14 directions=x models=elastic speedup=4 out='%s' slurm='%s'")
+                  :format(old, out .. "/old4.sbatch"), out .. "/old4.log")
+assert(status == 1 and log:find("holds a study made with speedup=2, not 4", 1, true), log)
 
 -- 2. Failures: recorded with the message, the others still run, exit status = their number.
 local bad = out .. "/bad"
