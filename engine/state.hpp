@@ -67,7 +67,8 @@ struct Caches {
   ServoContacts servo;  // the contacts between bodies, for the servo (store/groups.hpp)
   // Stores filled and swapped in place of allocating: the pairs a break step's broken bonds free
   // (process_breaks), and the pair list's other half, which a neighbour build or the merge of the
-  // freed pairs writes into (build_pairs, insert_pairs).
+  // freed pairs writes into (build_pairs, insert_pairs; kept between builds only where bonds can
+  // break).
   PairStore freed_pairs, spare_pairs;
   std::vector<std::vector<std::int32_t>> found_pairs;  // a neighbour build's, per chunk of particles
   // Idle group members (see Group::busy), per particle index; valid while idle_valid (the split

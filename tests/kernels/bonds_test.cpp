@@ -692,6 +692,38 @@ TEST(Bonds, InstallationForSomeIdsBondsOnlyThoseWhenTheBuildReorders) {
   }
 }
 
+// A neighbour build writes the list into the spare pair store and swaps it in. The previous list
+// stays as the next spare only where bonds can break (a fracture run rebuilds and merges freed
+// pairs every few dozen steps); elsewhere it is released, or every run would hold a second pair
+// list resident (neighbor/build.cpp).
+TEST(Bonds, TheSparePairListIsKeptOnlyWhereBondsCanBreak) {
+  for (const bool breakable : {false, true}) {
+    World w;
+    const int n = 4;
+    std::vector<std::int64_t> lower;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j)
+        for (int k = 0; k < n; ++k) {
+          const std::int64_t id = w.add_particle({i * 2 * kR, j * 2 * kR, k * 2 * kR}, kR);
+          if (k < n / 2) lower.push_back(id);
+        }
+    BondMaterial bm;
+    bm.breakable = breakable;
+    bm.tensile_strength = 1;
+    ASSERT_GT(w.install_bonds(bm, -1, lower), 0u);
+    w.rebuild_neighbors();
+    w.rebuild_neighbors();
+    const detail::State& s = w.state();
+    ASSERT_GT(s.pairs.n, 0u) << "the upper half's pairs are listed";
+    if (breakable) {
+      EXPECT_EQ(s.cache.spare_pairs.n, s.pairs.n) << "the previous list (nothing moved) kept as the spare";
+    } else {
+      EXPECT_EQ(s.cache.spare_pairs.a.capacity(), 0u) << "unbreakable bonds: the previous list released";
+      EXPECT_EQ(s.cache.spare_pairs.fn.capacity(), 0u);
+    }
+  }
+}
+
 // Bonds installed in a world that never ran keep the world's skin (the search for bonded pairs
 // needs only 2 x tolerance; once, that became the skin, and the list was rebuilt every step).
 TEST(Bonds, InstallingBeforeTheFirstStepKeepsTheSkin) {
