@@ -100,8 +100,12 @@ local directions = params_lib.split(P.directions)
 local models = params_lib.split(P.models)
 local seeds = {}
 for k, v in ipairs(params_lib.split(P.seeds, true)) do seeds[k] = math.tointeger(v) end
-local extra = {}
-for item in P.joint:gmatch("%S+") do extra[#extra + 1] = item end
+local function words(text)
+  local t = {}
+  for item in text:gmatch("%S+") do t[#t + 1] = item end
+  return t
+end
+local extra = words(P.joint)
 
 local sh = require("shell")
 local shell_quote, capture, absolute = sh.quote, sh.capture, sh.absolute
@@ -436,12 +440,8 @@ do
       if was == nil then was = made_without[k] end
       if was ~= settings[k] and params[k] == nil then
         log("%s=%s, as the study in %s was made (not given here)", k, tostring(was), DIR)
-        if k == "joint" then
-          extra = {}
-          for item in was:gmatch("%S+") do extra[#extra + 1] = item end
-        else
-          P[k] = was
-        end
+        P[k] = was
+        if k == "joint" then extra = words(was) end
       elseif was ~= settings[k] then
         fail("%s holds a study made with %s=%s, not %s: give another out= (or the same %s)", DIR, k,
              tostring(was), tostring(settings[k]), k)
