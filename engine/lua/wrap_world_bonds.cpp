@@ -74,10 +74,11 @@ int world_bond_count(lua_State* L) {
 
 int world_bonds(lua_State* L) {
   return guarded(L, [&] {
+    const std::vector<bool> fields = row_field_mask<BondInfo>(L, 2, "world:bonds");
     std::vector<BondInfo> bs = world_arg(L).bonds();
     lua_createtable(L, static_cast<int>(bs.size()), 0);
     for (std::size_t k = 0; k < bs.size(); ++k) {
-      push_row(L, bs[k]);
+      push_row(L, bs[k], &fields);
       lua_rawseti(L, -2, static_cast<lua_Integer>(k + 1));
     }
     return 1;
@@ -161,7 +162,8 @@ int bond_criterion(lua_State* L) {
 
 std::span<const Function> world_bond_methods() {
   static const std::string bonds_help = "Bonds of which a part holds: " + row_fields<BondInfo>() +
-                                        ";\nbeam and contact_bond say which part holds (model.md 5: they break separately).";
+                                        ";\nbeam and contact_bond say which part holds (model.md 5: they break separately);\n"
+                                        "fields: only those (a row of every field is about 1 kB of Lua memory).";
   static const std::string breaks_help =
       "Bond breaks so far (from number `first`): " + row_fields<BreakEvent>() +
       ";\nkind is \"beam\" (the parallel bond) or \"contact_bond\", mode \"tension\", \"compression\" or \"shear\".";
@@ -183,7 +185,7 @@ std::span<const Function> world_bond_methods() {
        "Deletes every bond (no break events; bonded pairs become ordinary contacts)."},
       {"save", world_save, "world:save(path)",
        "Writes a checkpoint (the whole state, HDF5); asperity.load(path) continues bit for bit."},
-      {"bonds", world_bonds, "world:bonds() -> {bond, ...}", bonds_help.c_str()},
+      {"bonds", world_bonds, "world:bonds([{fields = {name, ...}}]) -> {bond, ...}", bonds_help.c_str()},
       {"break_events", world_break_events, "world:break_events([first]) -> {event, ...}", breaks_help.c_str()},
       {"break_count", world_break_count, "world:break_count([kind]) -> n",
        "Breaks so far of kind \"beam\" (the default: parallel bonds, the thesis's broken bonds),\n"

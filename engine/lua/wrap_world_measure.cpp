@@ -57,10 +57,11 @@ int world_unbalanced_force_ratio(lua_State* L) {
 
 int world_contacts(lua_State* L) {
   return guarded(L, [&] {
+    const std::vector<bool> fields = row_field_mask<ContactInfo>(L, 2, "world:contacts");
     std::vector<ContactInfo> cs = world_arg(L).contacts();
     lua_createtable(L, static_cast<int>(cs.size()), 0);
     for (std::size_t k = 0; k < cs.size(); ++k) {
-      push_row(L, cs[k]);
+      push_row(L, cs[k], &fields);
       lua_rawseti(L, -2, static_cast<lua_Integer>(k + 1));
     }
     return 1;
@@ -81,7 +82,8 @@ int world_contact_count(lua_State* L) {
 }  // namespace
 
 std::span<const Function> world_measure_methods() {
-  static const std::string contacts_help = "Touching ball-ball pairs: " + row_fields<ContactInfo>() + ".";
+  static const std::string contacts_help = "Touching ball-ball pairs: " + row_fields<ContactInfo>() +
+                                           ";\nfields: only those (a row of every field is about 1 kB of Lua memory).";
   static const Function methods[] = {
       {"energies", world_energies, "world:energies() -> table",
        "kinetic, strain (now), friction, damping, boundary_work, gravity_work, released\n"
@@ -91,7 +93,7 @@ std::span<const Function> world_measure_methods() {
       {"unbalanced_force_ratio", world_unbalanced_force_ratio, "world:unbalanced_force_ratio() -> r",
        "Mean unbalanced force of the particles outside rigid groups / mean normal force of the\n"
        "touching contacts, wall contacts and intact bonds (PFC's equilibrium ratio)."},
-      {"contacts", world_contacts, "world:contacts() -> {contact, ...}", contacts_help.c_str()},
+      {"contacts", world_contacts, "world:contacts([{fields = {name, ...}}]) -> {contact, ...}", contacts_help.c_str()},
       {"contact_count", world_contact_count, "world:contact_count() -> n", "Touching ball-ball pairs."},
       {"max_overlap_ratio", world_max_overlap_ratio, "world:max_overlap_ratio() -> r",
        "Deepest overlap (touching pairs, wall contacts, bonds) / radius of the smaller body; 0 if none.\n"

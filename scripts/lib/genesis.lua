@@ -56,7 +56,7 @@ end
 -- Ball-ball contacts per particle id (touching pairs only).
 function M.contact_counts(world)
   local counts = {}
-  for _, c in ipairs(world:contacts()) do
+  for _, c in ipairs(world:contacts{fields = {"a", "b"}}) do
     counts[c.a] = (counts[c.a] or 0) + 1
     counts[c.b] = (counts[c.b] or 0) + 1
   end
@@ -564,7 +564,7 @@ function M.bond_stresses(world, tensile_strength, csv)
   local sig, tau, need = {}, {}, {}
   local f = csv and assert(io.open(csv, "w"))
   if f then f:write("a,b,sigma [Pa],tau [Pa],strength_to_hold [Pa]\n") end
-  for _, b in ipairs(world:bonds()) do
+  for _, b in ipairs(world:bonds{fields = {"a", "b", "sigma", "tau"}}) do
     local s = mat.strength_to_hold(b.sigma, b.tau)
     sig[#sig + 1], tau[#tau + 1], need[#need + 1] = b.sigma, b.tau, s
     if f then f:write(("%d,%d,%.10g,%.10g,%.10g\n"):format(b.a, b.b, b.sigma, b.tau, s)) end

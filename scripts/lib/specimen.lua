@@ -87,7 +87,7 @@ function M.gauges(world, o)
   -- bonded skeleton: it does not count.
   if world:bond_count() > 0 and o.bonded_only ~= false then
     local bonded = {}
-    for _, b in ipairs(world:bonds()) do bonded[b.a], bonded[b.b] = true, true end
+    for _, b in ipairs(world:bonds{fields = {"a", "b"}}) do bonded[b.a], bonded[b.b] = true, true end
     for id = 1, world:particle_count() do
       if not bonded[id] then skip[id] = true end
     end
@@ -183,8 +183,9 @@ function M.slab_stress(world, zlo, zhi, area)
       for j = 1, 3 do s[i][j] = s[i][j] + f[i] * l[j] end
     end
   end
-  for _, b in ipairs(world:bonds()) do add(b, b.normal_force, b.shear_force) end
-  for _, c in ipairs(world:contacts()) do add(c, c.normal_force, c.shear_force) end
+  local fields = {fields = {"a", "b", "point", "normal", "normal_force", "shear_force"}}
+  for _, b in ipairs(world:bonds(fields)) do add(b, b.normal_force, b.shear_force) end
+  for _, c in ipairs(world:contacts(fields)) do add(c, c.normal_force, c.shear_force) end
   local v = area * (zhi - zlo)
   for i = 1, 3 do
     for j = 1, 3 do s[i][j] = -s[i][j] / v end

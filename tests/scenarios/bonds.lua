@@ -69,4 +69,19 @@ local bond_keys = keys(w2:bonds()[1])
 assert(bond_keys == "a,b,beam,beam_radius,bending_moment,contact_bond,gap,normal,normal_force,point,shear_force,sigma,tau,twisting_moment",
        bond_keys)
 assert(keys(w2:break_events()[1]) == "a,b,kind,mode,position,released_energy,sigma,step,tau,time", keys(w2:break_events()[1]))
+-- `fields` lists only the fields asked for, with the same values; an unknown name or a list that
+-- is not one is refused by name.
+local whole, some = w2:bonds(), w2:bonds{fields = {"sigma", "b", "a"}}
+assert(#some == #whole and #some > 0)
+for k = 1, #whole do
+  assert(keys(some[k]) == "a,b,sigma", keys(some[k]))
+  assert(some[k].a == whole[k].a and some[k].b == whole[k].b and some[k].sigma == whole[k].sigma)
+end
+assert(keys(w2:bonds{fields = {}}[1]) == "")
+ok, err = pcall(w2.bonds, w2, {fields = {"a", "sigmaa"}})
+assert(not ok and tostring(err):find('fields%[2%] is "sigmaa", not a field; fields are {a, b,'), tostring(err))
+ok, err = pcall(w2.bonds, w2, {fields = "a"})
+assert(not ok and tostring(err):find("fields"), tostring(err))
+ok, err = pcall(w2.contacts, w2, {fields = {"overlap", 1}})
+assert(not ok and tostring(err):find("fields%[2%] is number"), tostring(err))
 print("PASS")

@@ -91,7 +91,7 @@ function Run:between() return self.world:contact_summary(M.LOWER, M.UPPER, M.POR
 -- The contact points between the halves, (x, y).
 function Run:points_between()
   local world, pts = self.world, {}
-  for _, ct in ipairs(world:contacts()) do
+  for _, ct in ipairs(world:contacts{fields = {"a", "b", "point"}}) do
     if world:tag(ct.a) ~= world:tag(ct.b) then pts[#pts + 1] = {ct.point[1], ct.point[2]} end
   end
   return pts

@@ -164,7 +164,7 @@ local function build(run)
     -- integrated nor searched) and tagged LOST, like those squeezed out, so no half, platen or
     -- measure counts them.
     local bonded, across = {}, 0
-    for _, bd in ipairs(w:bonds()) do
+    for _, bd in ipairs(w:bonds{fields = {"a", "b"}}) do
       bonded[bd.a], bonded[bd.b] = true, true
       if w:tag(bd.a) ~= w:tag(bd.b) then across = across + 1 end
     end

@@ -75,7 +75,7 @@ local function bonded(run)
     -- The bonds must hold what the preparation locked into them, or the "fracture" model is an
     -- unbonded pile that collapses at the first step. Say so instead of shearing it.
     local st = P.tensile_strength
-    local over, worst, all = 0, 0, world:bonds()
+    local over, worst, all = 0, 0, world:bonds{fields = {"sigma", "tau"}}
     for _, b in ipairs(all) do
       local need = mat.strength_to_hold(b.sigma, b.tau)
       if need > st then over = over + 1 end
