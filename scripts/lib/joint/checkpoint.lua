@@ -104,22 +104,37 @@ function Checkpoint:save(part)
   end
   for k, s in pairs(part.series or {}) do state.series[k] = persist.series_state(s) end
   local text = persist.encode(state)
-  local final, new_dir, old_dir = dir(P), dir(P) .. ".new", dir(P) .. ".old"
+  local new_dir = dir(P) .. ".new"
   remove_state(new_dir)
   asperity.mkdir(new_dir)
   run.world:save(new_dir .. "/world.h5")
   local f = assert(io.open(new_dir .. "/state.lua", "wb"))
   assert(f:write(text))
   assert(f:close())
-  -- The swap: the current state becomes .old (a folder without a state is what a cut save left:
-  -- it goes), the new one takes its place, then .old goes.
-  remove_state(old_dir)
-  if read(final .. "/state.lua") then assert(os.rename(final, old_dir)) else remove_state(final) end
-  assert(os.rename(new_dir, final))
-  remove_state(old_dir)
+  M.swap(P)
   self.saves = self.saves + 1
   self.last = asperity.wall_time()
   run:log("checkpoint %d at step %d (%s): %.1f s", self.saves, state.step, part.phase, self.last - t0)
+end
+
+-- The whole new state in OUT/.resume.new put in place of the current one, so that a kill at any
+-- moment leaves a whole state where find looks: OUT/.resume, or OUT/.resume.old while .resume is
+-- not whole. The current state is .resume if it holds a state, else .old (a run resumed from
+-- .old after a kill between the renames): .old goes only once .resume holds a state, or the
+-- current one would be lost until the new one is renamed in. `fs` (tests) replaces the file
+-- operations: rename(from, to), remove(path), has_state(path).
+function M.swap(P, fs)
+  fs = fs or {rename = function(a, b) assert(os.rename(a, b)) end, remove = remove_state,
+              has_state = function(path) return read(path .. "/state.lua") ~= nil end}
+  local final, new_dir, old_dir = dir(P), dir(P) .. ".new", dir(P) .. ".old"
+  if fs.has_state(final) then
+    fs.remove(old_dir)
+    fs.rename(final, old_dir)
+  else
+    fs.remove(final)  -- what a save cut short left, if anything
+  end
+  fs.rename(new_dir, final)
+  fs.remove(old_dir)
 end
 
 -- The saved state in OUT (nil if none), checked against the run's parameters. Also makes
