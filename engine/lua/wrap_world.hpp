@@ -2,6 +2,7 @@
 // method list each contributes to the type (open_world, wrap_world.cpp).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -84,13 +85,7 @@ std::vector<bool> row_field_mask(lua_State* L, int index, const std::string& con
 }
 template <class Row>
 void push_row(lua_State* L, const Row& row, const std::vector<bool>* mask = nullptr) {
-  int count = 0;
-  if (mask) {
-    for (const bool m : *mask) count += m;
-  } else {
-    count = 16;
-  }
-  lua_createtable(L, 0, count);
+  lua_createtable(L, 0, mask ? static_cast<int>(std::count(mask->begin(), mask->end(), true)) : 16);
   std::size_t f = 0;
   for_each_info(row, [&](const char* name, const auto& v) {
     if (!mask || (*mask)[f]) {
