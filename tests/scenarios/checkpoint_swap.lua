@@ -7,6 +7,7 @@
 -- the run's progress.)
 local checkpoint = require("joint.checkpoint")
 local persist = require("persist")
+local read = require("shell").read
 local out = assert(params.out, "give out=DIRECTORY")
 
 local P = {checkpoint_every = 5, out = out, model = "elastic", surface = "S1", stress = 14}
@@ -47,15 +48,14 @@ for name, start in pairs(starts) do
         return f(...)
       end
     end
-    local fs = {rename = op(function(a, b) assert(os.rename(a, b)) end), remove = op(asperity.remove_all),
-                has_state = function(path) return io.open(path .. "/state.lua") ~= nil end}
+    local fs = {rename = op(function(a, b) assert(os.rename(a, b)) end), remove = op(asperity.remove_all)}
     local ok, err = pcall(checkpoint.swap, P, fs)
     assert(ok or err == "killed", err)
     local step = found_step()
     assert(step == 1 or step == 2, ("%s, killed before operation %d: no whole state found"):format(name, kill))
     if ok then
       assert(step == 2, name .. ": a whole swap leaves the new state")
-      assert(io.open(out .. "/.resume.old/state.lua") == nil and io.open(out .. "/.resume.new/state.lua") == nil,
+      assert(not read(out .. "/.resume.old/state.lua") and not read(out .. "/.resume.new/state.lua"),
              name .. ": a whole swap leaves only .resume")
       break
     end

@@ -121,11 +121,12 @@ end
 -- moment leaves a whole state where find looks: OUT/.resume, or OUT/.resume.old while .resume is
 -- not whole. The current state is .resume if it holds a state, else .old (a run resumed from
 -- .old after a kill between the renames): .old goes only once .resume holds a state, or the
--- current one would be lost until the new one is renamed in. `fs` (tests) replaces the file
--- operations: rename(from, to), remove(path), has_state(path).
-function M.swap(P, fs)
-  fs = fs or {rename = function(a, b) assert(os.rename(a, b)) end, remove = remove_state,
+-- current one would be lost until the new one is renamed in. `given` (tests) replaces some of the
+-- file operations: rename(from, to), remove(path), has_state(path).
+function M.swap(P, given)
+  local fs = {rename = function(a, b) assert(os.rename(a, b)) end, remove = remove_state,
               has_state = function(path) return read(path .. "/state.lua") ~= nil end}
+  for k, f in pairs(given or {}) do fs[k] = f end
   local final, new_dir, old_dir = dir(P), dir(P) .. ".new", dir(P) .. ".old"
   if fs.has_state(final) then
     fs.remove(old_dir)
