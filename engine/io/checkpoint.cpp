@@ -596,8 +596,7 @@ World World::load(const std::string& path, int threads, const std::string& simd)
   // checks after loading are all they get), then opened from the bytes read.
   bool had_header = false;
   std::vector<unsigned char> bytes = io::h5::read_checked(path, kMagic, &had_header);
-  io::h5::Handle h = io::h5::open_image(bytes, path);
-  bytes = {};
+  io::h5::Handle h = io::h5::open_image(std::move(bytes), path);
   Reader r{h, path};
   int version = 0;
   r.scalar("asperity_checkpoint_version", version);

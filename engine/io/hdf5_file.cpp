@@ -7,7 +7,6 @@
 #include <bit>
 #include <cstring>
 #include <fstream>
-#include <iterator>
 
 namespace asperity::io::h5 {
 
@@ -122,10 +121,15 @@ std::vector<unsigned char> read_checked(const std::filesystem::path& path, const
   const std::string name = path.string();
   std::vector<unsigned char> bytes;
   {
-    std::ifstream in(path, std::ios::binary);
+    // Sized once and read in one call (filled through an iterator, the vector grew by doubling:
+    // two buffers of the file's size at once, and a third byte by byte).
+    std::ifstream in(path, std::ios::binary | std::ios::ate);
     if (!in) fail(name, "does not exist or cannot be read");
-    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    if (in.bad()) fail(name, "read error");
+    const std::streamoff size = in.tellg();
+    if (size < 0) fail(name, "cannot tell its size");
+    bytes.resize(static_cast<std::size_t>(size));
+    in.seekg(0);
+    if (!in.read(reinterpret_cast<char*>(bytes.data()), size)) fail(name, "read error");
   }
   const bool foreign = bytes.size() >= 8 && std::memcmp(bytes.data(), kHdf5Signature, 8) == 0;
   if (had_header) *had_header = !foreign;
@@ -144,16 +148,41 @@ std::vector<unsigned char> read_checked(const std::filesystem::path& path, const
   return bytes;
 }
 
-Handle open_image(const std::vector<unsigned char>& bytes, const std::filesystem::path& path) {
+namespace {
+// HDF5's core driver copies an image twice by default (into the property list, then into the
+// open file). These callbacks hand it our bytes instead (udata: their address), for a file
+// opened read only: nothing is ever allocated, resized or freed by HDF5, and the handle keeps
+// the bytes until the file is closed.
+void* image_in_place(std::size_t, H5FD_file_image_op_t op, void* udata) {
+  const bool ours = op == H5FD_FILE_IMAGE_OP_PROPERTY_LIST_SET || op == H5FD_FILE_IMAGE_OP_PROPERTY_LIST_COPY ||
+                    op == H5FD_FILE_IMAGE_OP_PROPERTY_LIST_GET || op == H5FD_FILE_IMAGE_OP_FILE_OPEN;
+  return ours ? udata : nullptr;  // a resize of a read-only file: refused
+}
+void* copy_in_place(void* dest, const void* src, std::size_t size, H5FD_file_image_op_t, void*) {
+  if (dest != src) std::memcpy(dest, src, size);
+  return dest;
+}
+herr_t free_nothing(void*, H5FD_file_image_op_t, void*) { return 0; }
+void* share_udata(void* udata) { return udata; }
+herr_t keep_udata(void*) { return 0; }
+}  // namespace
+
+Handle open_image(std::vector<unsigned char> bytes, const std::filesystem::path& path) {
   quiet_errors();
+  auto image = std::make_shared<const std::vector<unsigned char>>(std::move(bytes));
+  void* at = const_cast<unsigned char*>(image->data());
+  H5FD_file_image_callbacks_t in_place = {image_in_place, copy_in_place, nullptr, free_nothing,
+                                          share_udata, keep_udata, at};
   Handle access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
-  if (H5Pset_fapl_core(access, 1 << 20, 0) < 0 ||
-      H5Pset_file_image(access, const_cast<unsigned char*>(bytes.data()), bytes.size()) < 0)
+  // Closing the file closes what is still open in it: nothing reads the bytes after the handle.
+  if (H5Pset_fapl_core(access, 1 << 20, 0) < 0 || H5Pset_fclose_degree(access, H5F_CLOSE_STRONG) < 0 ||
+      H5Pset_file_image_callbacks(access, &in_place) < 0 || H5Pset_file_image(access, at, image->size()) < 0)
     fail(path.string(), "cannot set up an in-memory file");
-  // The core driver refuses a name that exists on disk when it opens an image; `path` is a file,
-  // so nothing can exist below it.
-  const std::string image_name = path.string() + "/(in memory)";
-  Handle f(H5Fopen(image_name.c_str(), H5F_ACC_RDONLY, access), H5Fclose);
+  // The core driver refuses a name that exists on disk when it opens an image (`path` is a file,
+  // so nothing can exist below it), and HDF5 shares one open file among openings of one name
+  // (this one reads our bytes: their address makes each opening its own file).
+  const std::string image_name = path.string() + "/(in memory at " + std::to_string(reinterpret_cast<std::uintptr_t>(at)) + ")";
+  Handle f(H5Fopen(image_name.c_str(), H5F_ACC_RDONLY, access), H5Fclose, std::move(image));
   if (!f.valid()) fail(path.string(), "cannot open (not an HDF5 file?)");
   return f;
 }

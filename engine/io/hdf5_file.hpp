@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -22,12 +23,16 @@ class Handle {
   using Closer = herr_t (*)(hid_t);
   Handle() = default;
   Handle(hid_t id, Closer close) : id_(id), close_(close) {}
-  Handle(Handle&& o) noexcept : id_(o.id_), close_(o.close_) { o.id_ = H5I_INVALID_HID; }
+  // A file opened on bytes in memory (open_image) keeps them until it is closed.
+  Handle(hid_t id, Closer close, std::shared_ptr<const std::vector<unsigned char>> image)
+      : id_(id), close_(close), image_(std::move(image)) {}
+  Handle(Handle&& o) noexcept : id_(o.id_), close_(o.close_), image_(std::move(o.image_)) { o.id_ = H5I_INVALID_HID; }
   Handle& operator=(Handle&& o) noexcept {
     if (this != &o) {
       reset();
       id_ = o.id_;
       close_ = o.close_;
+      image_ = std::move(o.image_);
       o.id_ = H5I_INVALID_HID;
     }
     return *this;
@@ -38,6 +43,7 @@ class Handle {
   void reset() {
     if (id_ >= 0 && close_) close_(id_);
     id_ = H5I_INVALID_HID;
+    image_.reset();  // after the close: HDF5 reads the file from it until then
   }
   hid_t get() const { return id_; }
   operator hid_t() const { return id_; }
@@ -46,6 +52,7 @@ class Handle {
  private:
   hid_t id_ = H5I_INVALID_HID;
   Closer close_ = nullptr;
+  std::shared_ptr<const std::vector<unsigned char>> image_;
 };
 
 void quiet_errors();
@@ -77,8 +84,9 @@ void write_image(hid_t file, const std::filesystem::path& temp, const std::strin
 // any asperity header, or none). *had_header tells which it was.
 std::vector<unsigned char> read_checked(const std::filesystem::path& path, const char* magic = nullptr,
                                         bool* had_header = nullptr);
-// A file opened (read only) from bytes of read_checked.
-Handle open_image(const std::vector<unsigned char>& bytes, const std::filesystem::path& path);
+// A file opened (read only) from bytes of read_checked, which the handle keeps: HDF5 reads them
+// in place, without a copy of its own.
+Handle open_image(std::vector<unsigned char> bytes, const std::filesystem::path& path);
 
 Handle open_file_read(const std::filesystem::path& path);
 Handle create_group(hid_t parent, const std::string& name, const std::string& file);
