@@ -57,9 +57,10 @@ local P = params_lib.parse{
   {"shear", 5, unit = "mm", above = 0, doc = "shear displacement"},
   {"residual_window", 0.5, unit = "mm", above = 0, doc = "the residual stress is the mean over the last this much of the shear"},
   {"velocity", 1.5e-5, unit = "m/s", above = 0, doc = "shear velocity (perf/runtime_vs_error.lua: within 1 % of a 4x slower run)"},
-  {"speedup", 1, type = "integer", oneof = {1, 2, 4},
+  {"speedup", 0, type = "integer", oneof = {0, 1, 2, 4},
    doc = "after the peak the shear velocity may double at each record, up to this many times "
-      .. "`velocity`, while the specimen stays quasi-static (speedup_kinetic); 1: constant velocity; the elastic model only"},
+      .. "`velocity`, while the specimen stays quasi-static (speedup_kinetic); 1: constant velocity; the elastic "
+      .. "model only (0: by model, 4 elastic, 1 rigid and fracture)"},
   {"speedup_drop", 0.25, above = 0, max = 1,
    doc = "past the peak: the shear stress below (1 - this) x the highest so far (above it again, the velocity steps back)"},
   {"speedup_kinetic", 0.002, above = 0,
@@ -140,8 +141,10 @@ local P = params_lib.parse{
          .. "and on SIGTERM; the same command resumes from it (0: never)"},
   {"stop_after", "", oneof = {"", "packing"}, doc = "packing: stop once the halves are packed, before bonding"},
   check = function(P, fail, given)
-    -- The default by model, chosen by perf/runtime_vs_error.lua (perf/README.md, "Heavier light particles").
+    -- The defaults by model, chosen by perf/runtime_vs_error.lua (perf/README.md, "Heavier light
+    -- particles" and "Loading rate after the peak").
     if P.mass_floor < 0 then P.mass_floor = P.model == "elastic" and 0.75 or 0 end
+    if P.speedup == 0 then P.speedup = P.model == "elastic" and 4 or 1 end
     if P.residual_window >= P.shear then
       fail("shear", ("must exceed the residual window (residual_window = %g mm): the residual is the "
                      .. "mean over the last residual_window of the shear"):format(P.residual_window))

@@ -47,9 +47,10 @@ local P = params_lib.parse{
   {"size", 0, unit = "m", min = 0, doc = "side of the joints (0: joint.lua's default)"},
   {"normal_stiffness", 0, unit = "MPa/mm", min = 0,
    doc = "> 0: every run under constant normal stiffness (normal_control=stiffness); 0: constant normal load"},
-  {"speedup", 1, type = "integer", oneof = {1, 2, 4},
+  {"speedup", 4, type = "integer", oneof = {1, 2, 4},
    doc = "joint.lua's speedup for the elastic runs (the loading rate may rise to this factor after the " ..
-   "peak); the rigid and fracture runs keep 1 (their results move with it; rigid runs take seconds)"},
+   "peak; 4 is joint.lua's elastic default); the rigid and fracture runs keep 1 (their results move with it; " ..
+   "rigid runs take seconds)"},
   {"events_every", 100, type = "integer", unit = "steps", min = 0,
    doc = "between the energy samples of the fracture runs, for the event statistics (0: none)"},
   {"joint", "", doc = "more key=value parameters for every joint.lua run, space-separated (not those the study sets)"},
@@ -169,7 +170,7 @@ local function command(run)
     args[#args + 1] = "normal_stiffness=" .. number_text(P.normal_stiffness)
   end
   if run.genesis_threads then args[#args + 1] = "genesis_threads=" .. run.genesis_threads end
-  if run.model == "elastic" and P.speedup > 1 then args[#args + 1] = "speedup=" .. P.speedup end
+  if run.model == "elastic" then args[#args + 1] = "speedup=" .. P.speedup end
   if run.model == "fracture" and P.events_every > 0 then args[#args + 1] = "events_every=" .. P.events_every end
   for _, item in ipairs(extra) do args[#args + 1] = item end
   args[#args + 1] = "threads=" .. threads

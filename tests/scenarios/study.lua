@@ -189,7 +189,7 @@ assert(ok and calls:find("%-%-array=0%-1 .* pack") and calls:find("%-%-array=0%-
 status, log = run(("surfaces=S2 stresses=21 directions=y models=elastic normal_stiffness=20 out='%s' slurm='%s'")
                   :format(out .. "/cns", out .. "/cns.sbatch"), out .. "/cns.log")
 assert(status == 0 and read(out .. "/cns.sbatch"):find(" surface=S2 stress=21 direction=y model=elastic seed=1 " ..
-       "normal_control=stiffness normal_stiffness=20 threads=", 1, true), "CNS command line:\n" .. tostring(read(out .. "/cns.sbatch")))
+       "normal_control=stiffness normal_stiffness=20 speedup=4 threads=", 1, true), "CNS command line:\n" .. tostring(read(out .. "/cns.sbatch")))
 -- speedup reaches the elastic runs, not the rigid and fracture ones (joint.lua refuses it there).
 status, log = run(("surfaces=S1 stresses=14 directions=x models=rigid,elastic,fracture speedup=4 out='%s' slurm='%s'")
                   :format(out .. "/fast", out .. "/fast.sbatch"), out .. "/fast.log")
@@ -199,6 +199,11 @@ for _, m in ipairs{"rigid", "elastic", "fracture"} do
   assert(status == 0 and line, "speedup study: no command line for " .. m .. ":\n" .. log)
   assert((line:find(" speedup=4 ", 1, true) ~= nil) == (m == "elastic"), m .. ": speedup=4 where joint.lua takes it: " .. line)
 end
+-- A study at constant velocity says so to its elastic runs (joint.lua's elastic default is 4).
+status, log = run(("surfaces=S1 stresses=14 directions=x models=elastic speedup=1 out='%s' slurm='%s'")
+                  :format(out .. "/steady", out .. "/steady.sbatch"), out .. "/steady.log")
+assert(status == 0 and (read(out .. "/steady.sbatch") or ""):find(" model=elastic seed=1 speedup=1 threads=", 1, true),
+       "speedup=1 study:\n" .. log .. tostring(read(out .. "/steady.sbatch")))
 status, log = run(("surfaces=S1 models=elastic out='%s' joint='speedup=2' slurm='%s'"):format(out .. "/fast2", out .. "/fast2.sbatch"),
                   out .. "/fast2.log")
 assert(status ~= 0 and log:find("speedup", 1, true) and log:find("set by the study itself", 1, true), "joint='speedup=' refused:\n" .. log)
