@@ -155,8 +155,8 @@ namespace {
 // the bytes until the file is closed.
 void* image_in_place(std::size_t, H5FD_file_image_op_t op, void* udata) {
   const bool ours = op == H5FD_FILE_IMAGE_OP_PROPERTY_LIST_SET || op == H5FD_FILE_IMAGE_OP_PROPERTY_LIST_COPY ||
-                    op == H5FD_FILE_IMAGE_OP_PROPERTY_LIST_GET || op == H5FD_FILE_IMAGE_OP_FILE_OPEN;
-  return ours ? udata : nullptr;  // a resize of a read-only file: refused
+                    op == H5FD_FILE_IMAGE_OP_FILE_OPEN;
+  return ours ? udata : nullptr;  // a copy handed out (H5Pget_file_image) or a resize: refused
 }
 void* copy_in_place(void* dest, const void* src, std::size_t size, H5FD_file_image_op_t, void*) {
   if (dest != src) std::memcpy(dest, src, size);
