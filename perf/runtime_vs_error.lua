@@ -9,7 +9,7 @@
 --   build/asperity run perf/runtime_vs_error.lua                                  -- the default joint
 --   build/asperity run perf/runtime_vs_error.lua size=0.012 thickness=0.004 shear=2 out=out/rve_small
 --   build/asperity run perf/runtime_vs_error.lua only=reference,default,velocity_x2
---   build/asperity run perf/runtime_vs_error.lua size=0.05 reference=slower only=reference,default,speedup_4
+--   build/asperity run perf/runtime_vs_error.lua size=0.05 reference=slower only=reference,default,speedup_1
 --   build/asperity run perf/runtime_vs_error.lua scene=rev out=out/rve_rev        -- the REV (~15 min)
 --
 -- Writes into `out`: runtime_vs_error.csv (one row per setting, in the order below),
@@ -66,10 +66,11 @@ local scenes = {
       strict and {"reference", "velocity / 4, dt 0.5 x estimate, records / 4", {velocity = v / 4, dt_safety = 0.5, record = rec / 4,
                                                                                   speedup = 1, mass_floor = 0}}
              or {"reference", "velocity / 4", {velocity = v / 4, speedup = 1, mass_floor = 0}},
-      {"default", "the joint's defaults (elastic: mass floor 0.75)", {}},
+      {"default", "the joint's defaults (elastic: mass floor 0.75, speedup 4)", {}},
       {"velocity_x0.5", "velocity / 2", {velocity = v / 2}},
       {"velocity_x2", "velocity x 2", {velocity = 2 * v}},
       {"velocity_x4", "velocity x 4", {velocity = 4 * v}},
+      {"speedup_1", "constant velocity (joint.lua speedup; the elastic default is 4)", {speedup = 1}},
       {"speedup_2", "after the peak up to 2 x velocity (joint.lua speedup)", {speedup = 2}},
       {"speedup_4", "after the peak up to 4 x velocity", {speedup = 4}},
       {"dt_0.5", "dt 0.5 x estimate", {dt_safety = 0.5}},
@@ -139,6 +140,15 @@ end
 local settings = scene.settings
 local wanted = {}
 for name in P.only:gmatch("[^,]+") do wanted[name] = true end
+do
+  local names, known = {}, {}
+  for _, s in ipairs(settings) do names[#names + 1] = s[1]; known[s[1]] = true end
+  for name in pairs(wanted) do
+    if not known[name] then
+      error(("only: no setting '%s' for scene %s; the settings: %s"):format(name, P.scene, table.concat(names, ", ")), 0)
+    end
+  end
+end
 if next(wanted) and not wanted.reference then wanted.reference = true end
 
 local function run(name, overrides)
