@@ -13,12 +13,13 @@ void run_stages(State& s, std::initializer_list<StageLoop*> stages);
 double estimate_critical_dt(const State& s);
 // The deepest contact overlap relative to the radius of the smaller body it joins (a wall counts
 // as infinitely large), over touching pairs, wall contacts and bonds; particle -1 and ratio 0
-// when nothing overlaps.
+// when nothing overlaps. turning_only: only the contacts with a particle that turns freely, the
+// ones whose contact point and lever arm [3-11] enter the motion.
 struct OverlapRatio {
   double ratio = 0;
   std::int64_t particle = -1;
 };
-OverlapRatio deepest_overlap(const State& s);
+OverlapRatio deepest_overlap(const State& s, bool turning_only = false);
 Energies compute_energies(const State& s);
 void watch_load(State& s);  // StepContext::load_limit, for automatic threads
 

@@ -86,7 +86,9 @@ std::vector<ContactInfo> World::contacts() const {
   return out;
 }
 
-double World::max_overlap_ratio() const { return detail::deepest_overlap(*state_).ratio; }
+double World::max_overlap_ratio(bool turning_only) const {
+  return detail::deepest_overlap(*state_, turning_only).ratio;
+}
 
 std::size_t World::contact_count() const {
   const auto& q = state_->pairs;

@@ -69,7 +69,8 @@ local P = params_lib.parse{
    doc = "the shear velocity, and the upper half's approach, rise linearly from 0 over this displacement"},
   {"quasi_static_limit", 0.01, above = 0, doc = "warn when the kinetic energy exceeds this x normal load x mean radius"},
   {"overlap_limit", 0.5, above = 0, max = 1,
-   doc = "warn when a contact overlaps this fraction of the smaller radius (the engine stops at overlap_stop)"},
+   doc = "warn when a contact of a particle free to turn overlaps this fraction of the smaller radius, its contact "
+         .. "point and lever arm then far from a shallow contact's (the engine stops at overlap_stop)"},
   {"overlap_stop", 0, min = 0, max = 1.9,
    doc = "the engine stops the run at an overlap of this many smaller radii (0: 1, the rigid model 1.9)"},
   {"normal_control", "servo", oneof = {"servo", "load", "stiffness"},

@@ -107,14 +107,7 @@ int map_analyze(lua_State* L) {
     lua_createtable(L, 0, 12);
     push_plane(L, r.mean_plane);
     lua_setfield(L, -2, "mean_plane");
-    push_amplitude(L, r.amplitude);
-    lua_setfield(L, -2, "amplitude");
-    set_number(L, "correlation_length", r.correlation_length);
-    set_number(L, "rolloff_length", r.rolloff_length);
-    push_fit(L, r.hurst_structure);
-    lua_setfield(L, -2, "hurst_structure");
-    push_fit(L, r.hurst_psd);
-    lua_setfield(L, -2, "hurst_psd");
+    set_roughness_common(L, r);
     push_lag_series(L, r.structure_radial);
     lua_setfield(L, -2, "structure_radial");
     push_lag_series(L, r.structure_x);

@@ -137,14 +137,7 @@ int l_analyze_profile(lua_State* L) {
     set_number(L, "a", r.mean_line.a);
     set_number(L, "c", r.mean_line.c);
     lua_setfield(L, -2, "mean_line");
-    push_amplitude(L, r.amplitude);
-    lua_setfield(L, -2, "amplitude");
-    set_number(L, "correlation_length", r.correlation_length);
-    set_number(L, "rolloff_length", r.rolloff_length);
-    push_fit(L, r.hurst_structure);
-    lua_setfield(L, -2, "hurst_structure");
-    push_fit(L, r.hurst_psd);
-    lua_setfield(L, -2, "hurst_psd");
+    set_roughness_common(L, r);
     push_lag_series(L, r.structure);
     lua_setfield(L, -2, "structure");
     push_spectrum(L, r.psd);

@@ -113,6 +113,19 @@ inline void push_amplitude(lua_State* L, const sf::AmplitudeStats& a) {
   set_integer(L, "count", static_cast<lua_Integer>(a.count));
 }
 
+// The fields a map's and a profile's roughness summaries share, into the table on top.
+template <class Summary>
+void set_roughness_common(lua_State* L, const Summary& r) {
+  push_amplitude(L, r.amplitude);
+  lua_setfield(L, -2, "amplitude");
+  set_number(L, "correlation_length", r.correlation_length);
+  set_number(L, "rolloff_length", r.rolloff_length);
+  push_fit(L, r.hurst_structure);
+  lua_setfield(L, -2, "hurst_structure");
+  push_fit(L, r.hurst_psd);
+  lua_setfield(L, -2, "hurst_psd");
+}
+
 inline void push_plane(lua_State* L, const sf::Plane& p) {
   lua_createtable(L, 0, 3);
   set_number(L, "a", p.a);

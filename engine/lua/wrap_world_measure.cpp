@@ -69,7 +69,11 @@ int world_contacts(lua_State* L) {
 }
 
 int world_max_overlap_ratio(lua_State* L) {
-  return guarded(L, [&] { lua_pushnumber(L, world_arg(L).max_overlap_ratio()); return 1; });
+  return guarded(L, [&] {
+    const bool turning_only = lua_isnoneornil(L, 2) ? false : check_boolean(L, 2);
+    lua_pushnumber(L, world_arg(L).max_overlap_ratio(turning_only));
+    return 1;
+  });
 }
 
 int world_contact_count(lua_State* L) {
@@ -95,9 +99,11 @@ std::span<const Function> world_measure_methods() {
        "touching contacts, wall contacts and intact bonds (PFC's equilibrium ratio)."},
       {"contacts", world_contacts, "world:contacts([{fields = {name, ...}}]) -> {contact, ...}", contacts_help.c_str()},
       {"contact_count", world_contact_count, "world:contact_count() -> n", "Touching ball-ball pairs."},
-      {"max_overlap_ratio", world_max_overlap_ratio, "world:max_overlap_ratio() -> r",
+      {"max_overlap_ratio", world_max_overlap_ratio, "world:max_overlap_ratio([turning_only]) -> r",
        "Deepest overlap (touching pairs, wall contacts, bonds) / radius of the smaller body; 0 if none.\n"
-       "A step past 1 stops with a health error; well before, the contacts are soft for the load."},
+       "A step past 1 stops with a health error; well before, the contacts are soft for the load.\n"
+       "turning_only = true: only contacts with a particle free to turn (not rotation-locked, not\n"
+       "inert, not in a group of fixed rotation), where contact point and lever arm enter the motion."},
       {"settings", world_settings, "world:settings() -> table", "The settings the world was made with."},
   };
   return methods;

@@ -541,7 +541,10 @@ class World {
   // The deepest overlap of a touching pair, wall contact or bond over the radius of the smaller
   // body (a wall's contact: the particle's); 0 when nothing overlaps. A step stops with a
   // HealthError past 1; well before that the soft contacts of model.md 9 are soft for the load.
-  double max_overlap_ratio() const;
+  // turning_only: only the contacts with a particle that turns freely (not rotation-locked, not
+  // inert, not in a group of fixed rotation): where the contact point and lever arm [3-11] enter
+  // the motion. Elsewhere a deep overlap leaves the linear law's forces as they are.
+  double max_overlap_ratio(bool turning_only = false) const;
 
   // --- checkpoints ---------------------------------------------------------------------------
   // The whole state in one HDF5 file (written to a temporary name, then renamed); a world loaded

@@ -222,6 +222,43 @@ TEST(Health, MaxOverlapRatioIsTheDeepestOverlapOverTheSmallerRadius) {
   EXPECT_NEAR(w.max_overlap_ratio(), 0.45, 1e-9);
 }
 
+// turning_only keeps the contacts with a particle free to turn: the deepest overlap of the joint's
+// bonded halves (rotation-locked by their bonds) and rigid platens (groups of fixed rotation)
+// does not count, a free particle's contact does, whichever side it is on.
+TEST(Health, MaxOverlapRatioTurningOnlyCountsContactsWithAParticleFreeToTurn) {
+  WorldSettings ws;
+  ws.dt = 1e-12;
+  World w(ws);
+  // Free pair: radii 1 and 0.5 mm, U = 0.1 mm, 0.2 of the smaller radius.
+  const auto a = w.add_particle({0, 0, 0}, 1e-3);
+  const auto b = w.add_particle({1.4e-3, 0, 0}, 0.5e-3);
+  // Bonded pair (locked by its bond, lock_bonded_rotation), pressed 0.45 of the smaller radius.
+  const auto c = w.add_particle({0, 10e-3, 0}, 1e-3);
+  const auto d = w.add_particle({0, 10e-3 + 1.55e-3, 0}, 1e-3);
+  const std::vector<std::int64_t> cd{c, d};
+  BondMaterial bm;
+  bm.breakable = false;
+  EXPECT_EQ(w.install_bonds(bm, -1, cd), 1u);
+  // A rigid group of fixed rotation (the default motion) whose members overlap 0.35.
+  const auto e = w.add_particle({0, 20e-3, 0}, 1e-3);
+  const auto f = w.add_particle({0, 20e-3 + 1.65e-3, 0}, 1e-3);
+  const std::vector<std::int64_t> ef{e, f};
+  w.add_group(ef);
+  w.cycle(1);
+  EXPECT_NEAR(w.max_overlap_ratio(), 0.45, 1e-9) << "every contact";
+  EXPECT_NEAR(w.max_overlap_ratio(true), 0.2, 1e-9) << "the free pair only";
+  // One side of the free pair locked: the other still turns.
+  w.set_rotation_locked(a, true);
+  EXPECT_NEAR(w.max_overlap_ratio(true), 0.2, 1e-9);
+  w.set_rotation_locked(b, true);
+  EXPECT_EQ(w.max_overlap_ratio(true), 0.0) << "nothing turns";
+  EXPECT_NEAR(w.max_overlap_ratio(), 0.45, 1e-9);
+  // A free particle pressed on a group member: the contact counts.
+  w.add_particle({1.7e-3, 20e-3, 0}, 1e-3);
+  w.cycle(1);
+  EXPECT_NEAR(w.max_overlap_ratio(true), 0.3, 1e-9);
+}
+
 // Dimensional consistency of the whole step. In the linear model, multiplying every stiffness
 // (contacts, walls, beams) by 4, gravity and bond strength by 4 (accelerations, stresses), and
 // the prescribed velocities by 2 while halving dt is the same motion at twice the speed: forces

@@ -31,7 +31,8 @@ local FREE = {threads = true, genesis_threads = true, progress = true, checkpoin
 -- this value (the behaviour before it existed), so it resumes where that value is given.
 local MADE_WITHOUT = {mass_floor = 0, genesis_mass_floor = 0, genesis_damping = 0.7, rotation_lock_beams = false}
 -- The run's fields (joint/context.lua) that the closure and the shear change and the report reads.
-local RUN_FIELDS = {"ramp_steps", "moved_steps", "overlap_max", "overlap_at", "escaped_count", "escape_box",
+local RUN_FIELDS = {"ramp_steps", "moved_steps", "overlap_max", "overlap_at", "overlap_turning_max",
+                    "overlap_turning_at", "escaped_count", "escape_box",
                     "z_contact", "normal_stiffness", "applied_z", "axis", "c0", "e0", "dynamic_ratio",
                     "dynamic_at", "shear_impulse", "peak_points", "speedup_max", "speedup_from",
                     "specimen_packed", "specimen_seconds"}
@@ -184,6 +185,9 @@ function M.restore(run, state)
       state.path, run.world:step(), state.step), 0)
   end
   for _, k in ipairs(RUN_FIELDS) do run[k] = state.run[k] end
+  -- A state saved before the turning particles' overlap was tracked: the deepest of any contact
+  -- bounds it.
+  if run.overlap_turning_max == nil then run.overlap_turning_max, run.overlap_turning_at = run.overlap_max, run.overlap_at end
   for _, k in ipairs(SERIES) do
     if state.series[k] then run[k] = persist.series_from(state.series[k]) end
   end

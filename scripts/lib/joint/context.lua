@@ -8,7 +8,7 @@
 --
 -- What the phases leave in it:
 --   new        P, t_start, stress_scale, target_stress (model Pa), applied_z, overlap_max,
---              overlap_at, escaped_count
+--              overlap_at, overlap_turning_max, overlap_turning_at, escaped_count
 --   checkpoint checkpoint (joint/checkpoint.lua: saves the state, resumes from it), resumes
 --   genesis    surface (the height map and the mould), cache_file, world, genesis_record
 --   assembly   N, lower, upper (ids of the halves), upper_mean_z_mould, pos, rad, prof_lower,
@@ -41,6 +41,7 @@ function M.new(P)
   run.target_stress = P.stress * 1e6 / run.stress_scale                -- model units, Pa
   run.applied_z = 0          -- the dead load on the upper platen (normal_control=load)
   run.overlap_max, run.overlap_at = 0, "closure"
+  run.overlap_turning_max, run.overlap_turning_at = 0, "closure"
   run.escaped_count = 0
   return run
 end
@@ -108,14 +109,17 @@ function Run:normal_stress() return self:platen_force()[3] / self.area end
 -- The shear displacement (mm) of the upper platen along -axis since the shear began.
 function Run:displacement() return (self.c0[self.axis] - self.world:group_position(self.top)[self.axis]) * 1e3 end
 
--- The deepest overlap of any contact or bond over the smaller radius, read at every record. At the
--- study's loads single asperity contacts are pressed 0.3-0.45 of a radius deep (perf/README.md,
--- "Contacts soft for the load"); deeper ones mean the contacts are too soft for the load, and the
--- contact points and lever arms [3-11] lose their sense long before the engine's health check
--- stops the run at one radius.
+-- The deepest overlap over the smaller radius, read at every record: of any contact or bond, and of
+-- the contacts with a particle free to turn. Only there do the contact point and its lever arm
+-- [3-11] enter the motion: the bonded halves do not turn (the rotation rule) and the rigid ones
+-- are groups of fixed rotation, so their deep contacts leave the linear law's forces as they are.
+-- The study's loads press single contacts of the 5 cm halves 0.34-0.79 of a radius deep (elastic;
+-- rigid 0.59-1.72, results/study); the engine's health check stops a run at one radius (1.9 rigid).
 function Run:track_overlap(where)
   local r = self.world:max_overlap_ratio()
   if r > self.overlap_max then self.overlap_max, self.overlap_at = r, where end
+  local t = self.world:max_overlap_ratio(true)
+  if t > self.overlap_turning_max then self.overlap_turning_max, self.overlap_turning_at = t, where end
 end
 
 -- Debris that leaves the specimen: a particle freed by breaks can be thrown out through the open

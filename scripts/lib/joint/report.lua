@@ -137,11 +137,17 @@ function M.write(run)
             .. "(limit quasi_static_limit = %g); results depend on the loading rate: lower velocity (now %g m/s)",
             dynamic_ratio, dynamic_at, P.quasi_static_limit, P.velocity)
   end
-  local overlap_max = run.overlap_max
-  if overlap_max > P.overlap_limit then
-    run:log("WARNING: a contact overlapped %.3g of its smaller radius (%s; limit overlap_limit = %g): the contacts "
-            .. "are too soft for the load, and contact points and lever arms lose their sense; lower the normal "
-            .. "stress (now %g MPa)", overlap_max, run.overlap_at, P.overlap_limit, P.stress)
+  local overlap_max, turning_max = run.overlap_max, run.overlap_turning_max
+  if turning_max > P.overlap_limit then
+    run:log("WARNING: a contact of a particle free to turn overlapped %.3g of its smaller radius (%s; limit "
+            .. "overlap_limit = %g): its contact point and lever arm are far from a shallow contact's, so the "
+            .. "particle's moments are those of contacts too soft for the load (%g MPa)",
+            turning_max, run.overlap_turning_at, P.overlap_limit, P.stress)
+  elseif overlap_max > P.overlap_limit then
+    run:log("deepest overlap %.3g of the smaller radius (%s), between particles that do not turn (bonded or "
+            .. "rigid): the linear law's forces are unaffected; contact points drawn at it lie off (the "
+            .. "particles free to turn: %.3g, limit overlap_limit = %g)", overlap_max, run.overlap_at, turning_max,
+            P.overlap_limit)
   end
   -- Initial shear stiffness: slope over the first 30 % of the peak stress.
   local sx, sy = {}, {}
@@ -219,7 +225,9 @@ function M.write(run)
     speedup_from_mm = run.speedup_from,        -- where it first rose above 1 (nil: never)
     overlap_ratio_max = overlap_max,           -- deepest overlap / smaller radius, over every record
     overlap_ratio_max_at = run.overlap_at,
-    overlaps_small = overlap_max <= P.overlap_limit,
+    overlap_ratio_max_turning = turning_max,   -- the same over the contacts with a particle free to turn
+    overlap_ratio_max_turning_at = run.overlap_turning_at,
+    overlaps_small = turning_max <= P.overlap_limit,
     initial_shear_stiffness_mpa_per_mm = ks,
     max_dilatancy_mm = max_dil,
     dilatancy_angle_at_peak_deg = math.deg(math.atan(slope_at(at))),
