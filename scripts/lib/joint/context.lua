@@ -140,12 +140,20 @@ function Run:set_escape_box(shear_reach)
   self.escape_box = box
 end
 
+-- A fracture run throws out debris a particle at a time, over a hundred at 5 cm: the log says so
+-- when the count reaches 1, 2, 4, 8, ... (the report gives the total).
 function Run:remove_escaped()
   local out = specimen.take_out_escaped(self.world, self.escape_box, M.LOST)
   if #out == 0 then return end
-  self.escaped_count = self.escaped_count + #out
-  self:log("%d particle%s thrown out of the specimen: taken out (%d so far)", #out, #out == 1 and "" or "s",
-           self.escaped_count)
+  local before = self.escaped_count
+  self.escaped_count = before + #out
+  local next_power = 1
+  while next_power <= before do next_power = 2 * next_power end
+  if self.escaped_count >= next_power then
+    while next_power <= self.escaped_count do next_power = 2 * next_power end
+    self:log("%d particle%s thrown out of the specimen so far, taken out (next said at %d)", self.escaped_count,
+             self.escaped_count == 1 and "" or "s", next_power)
+  end
 end
 
 -- Least-squares slope of ys against xs (NaN for fewer than two points).

@@ -137,6 +137,10 @@ function M.write(run)
             .. "(limit quasi_static_limit = %g); results depend on the loading rate: lower velocity (now %g m/s)",
             dynamic_ratio, dynamic_at, P.quasi_static_limit, P.velocity)
   end
+  if run.escaped_count > 0 then
+    run:log("%d particle%s thrown out of the specimen in all, taken out (escaped_particles)", run.escaped_count,
+            run.escaped_count == 1 and "" or "s")
+  end
   local overlap_max, turning_max = run.overlap_max, run.overlap_turning_max
   if turning_max > P.overlap_limit then
     run:log("WARNING: a contact of a particle free to turn overlapped %.3g of its smaller radius (%s; limit "
