@@ -187,7 +187,9 @@ function M.restore(run, state)
   for _, k in ipairs(RUN_FIELDS) do run[k] = state.run[k] end
   -- A state saved before the turning particles' overlap was tracked: the deepest of any contact
   -- bounds it.
-  if run.overlap_turning_max == nil then run.overlap_turning_max, run.overlap_turning_at = run.overlap_max, run.overlap_at end
+  if run.overlap_turning_max == nil then
+    run.overlap_turning_max, run.overlap_turning_at = run.overlap_max, run.overlap_at
+  end
   for _, k in ipairs(SERIES) do
     if state.series[k] then run[k] = persist.series_from(state.series[k]) end
   end

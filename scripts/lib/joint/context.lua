@@ -142,17 +142,20 @@ end
 
 -- A fracture run throws out debris a particle at a time, over a hundred at 5 cm: the log says so
 -- when the count reaches 1, 2, 4, 8, ... (the report gives the total).
+local function power_of_two_above(n)
+  local p = 1
+  while p <= n do p = 2 * p end
+  return p
+end
+
 function Run:remove_escaped()
   local out = specimen.take_out_escaped(self.world, self.escape_box, M.LOST)
   if #out == 0 then return end
   local before = self.escaped_count
   self.escaped_count = before + #out
-  local next_power = 1
-  while next_power <= before do next_power = 2 * next_power end
-  if self.escaped_count >= next_power then
-    while next_power <= self.escaped_count do next_power = 2 * next_power end
+  if self.escaped_count >= power_of_two_above(before) then
     self:log("%d particle%s thrown out of the specimen so far, taken out (next said at %d)", self.escaped_count,
-             self.escaped_count == 1 and "" or "s", next_power)
+             self.escaped_count == 1 and "" or "s", power_of_two_above(self.escaped_count))
   end
 end
 
