@@ -51,7 +51,7 @@ local function rigid(run)
     if p[3] - rad[id] > local_extreme(g, up_s, p[1], p[2], reach, true) + reach then inert[#inert + 1] = id end
   end
   if #inert > 0 then world:set_inert(inert) end
-  run:log("rigid model: %d of %d particles inert", #inert, run.N)
+  run:log("rigid model: %d of the halves' %d particles inert", #inert, #run.lower + #run.upper)
 end
 
 -- Bonded models: the mass floor, the bond strength, then the platens.
