@@ -219,11 +219,12 @@ void check_overlaps(State& s) {
 OverlapRatio deepest_overlap(const State& s, bool turning_only) {
   const ParticleStore& p = s.p;
   OverlapRatio worst;
-  // A particle turns unless its rotation is locked (settings, API, bonds), it is inert, or it is a
-  // member of a group whose rotation is fixed (the joint's halves and platens): a particle that
-  // does not turn feels neither the contact point nor the moment of its forces.
+  // A particle turns unless its rotation is locked (settings, API, bonds) or it is a member of a
+  // group whose rotation is fixed (the joint's halves and platens; inert members and worlds
+  // without rotation allow no other): a particle that does not turn feels neither the contact
+  // point nor the moment of its forces.
   auto turns = [&](std::int64_t i) {
-    if (i < 0 || !s.settings.rotation || p.inert[std::size_t(i)]) return false;
+    if (i < 0) return false;  // a wall
     const std::int32_t g = p.group[std::size_t(i)];
     if (g >= 0) return s.groups[std::size_t(g)].motion.rotation != Dof::fixed;
     return p.rotation_locked[std::size_t(i)] == 0;
