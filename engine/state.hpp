@@ -57,9 +57,15 @@ struct Caches {
   // Some bond lost its beam or its contact bond (BondStore::holds): the bond kernel reads what
   // holds; else every bond holds both and the column is not read. Set by refresh_bond_topology.
   bool bonds_partial = false;
-  // The layout of the bond records the last bond stage wrote (store/bonds.hpp): with the moment
-  // (12 doubles a bond) or, by the kernel without moments, without (8). The gather reads them so.
-  bool bond_records_with_moments = true;
+  // Some particle holding a bond the step computes turns (particle_turns): the bond records must
+  // carry the torque of the bonds' shear forces. Valid while bond_ends_turn_known: cleared by a
+  // new bond topology and by the API (membership, group motions); a break can only free the
+  // broken bonds' ends, which refresh_bond_topology_after_breaks looks at.
+  bool bond_ends_turn_known = false, bond_ends_turn = true;
+  // The layout of the bond records the last bond stage wrote (store/bonds.hpp, BondRecord): with
+  // the moment (12 doubles a bond), without (8: every moment zero) or forces only (4: besides, no
+  // end of a bond turns). The gather reads them so, and World::torque adds the terms left out.
+  kernels::BondRecord bond_records = kernels::BondRecord::moments;
   // Fewer than half the pair records were live when the pair kernel last counted them
   // (PairStore::live_current): the kernel flags them and the gather skips the dead ones
   // (stages/pairs.cpp). Kept here: a neighbour build replaces the pair store.
@@ -137,6 +143,15 @@ struct State {
   Caches cache;
 };
 
+// Whether particle i turns: its rotation is neither locked (settings, API, bonds: model.md 2) nor
+// fixed by its group (the joint's halves and platens; inert members and worlds without rotation
+// allow no other). Only then do the contact points and the moments of its forces move it.
+inline bool particle_turns(const State& s, std::size_t i) {
+  const std::int32_t g = s.p.group[i];
+  if (g >= 0) return s.groups[std::size_t(g)].motion.rotation != Dof::fixed;
+  return s.p.rotation_locked[i] == 0;
+}
+
 // What a World call changed, for changed(): the one place that says what must be redone.
 enum class Change {
   particles,       // positions, radii, membership...: rebuild; kinetic energy, its reference, spins
@@ -155,6 +170,7 @@ inline void changed(State& s, Change c) {
       s.reference_energy = -1;
       s.kinetic_valid = false;
       s.cache.spin_known = false;
+      s.cache.bond_ends_turn_known = false;  // group membership
       break;
     case Change::velocities:
       s.reference_energy = -1;
@@ -169,6 +185,7 @@ inline void changed(State& s, Change c) {
     case Change::group_motion:
       s.cache.idle_valid = false;  // the split syncs the lazy members first
       s.cache.spin_known = false;
+      s.cache.bond_ends_turn_known = false;
       break;
     case Change::time_step:
       s.last_estimate_step = 0;

@@ -216,19 +216,27 @@ void check_overlaps(State& s) {
 
 }  // namespace
 
+Vec3 bond_torque_left_out(const State& s, std::size_t i) {
+  if (s.cache.bond_records != kernels::BondRecord::forces) return {};
+  const Incidence& inc = s.cache.bond_incidence;
+  const BondStore& q = s.bonds;
+  Vec3 t{0, 0, 0};
+  // The gather's terms -(R - U/2) n x (fs + fbs) (gather_loop.hpp), from the record's values as
+  // the bond kernel stored them.
+  for (std::int32_t e = inc.start[i]; e < inc.start[i + 1]; ++e) {
+    const auto k = std::size_t(inc.entry[std::size_t(e)] >> 1);
+    const Vec3 n{q.nx[k], q.ny[k], q.nz[k]};
+    const Vec3 shear{q.fsx[k] + q.fbsx[k], q.fsy[k] + q.fbsy[k], q.fsz[k] + q.fbsz[k]};
+    t -= cross(n, shear) * (s.p.radius[i] - 0.5 * q.overlap[k]);
+  }
+  return t;
+}
+
 OverlapRatio deepest_overlap(const State& s, bool turning_only) {
   const ParticleStore& p = s.p;
   OverlapRatio worst;
-  // A particle turns unless its rotation is locked (settings, API, bonds) or it is a member of a
-  // group whose rotation is fixed (the joint's halves and platens; inert members and worlds
-  // without rotation allow no other): a particle that does not turn feels neither the contact
-  // point nor the moment of its forces.
-  auto turns = [&](std::int64_t i) {
-    if (i < 0) return false;  // a wall
-    const std::int32_t g = p.group[std::size_t(i)];
-    if (g >= 0) return s.groups[std::size_t(g)].motion.rotation != Dof::fixed;
-    return p.rotation_locked[std::size_t(i)] == 0;
-  };
+  // A particle that does not turn feels neither the contact point nor the moment of its forces.
+  auto turns = [&](std::int64_t i) { return i >= 0 && particle_turns(s, std::size_t(i)); };  // i < 0: a wall
   auto consider = [&](double U, std::int64_t a, std::int64_t b) {
     if (!(U > 0)) return;
     if (turning_only && !turns(a) && !turns(b)) return;
@@ -452,8 +460,8 @@ PairStageView pair_view(State& s) {
 BondStageView bond_view(State& s) {
   return {s.p, s.bonds, s.settings.contact, s.dt, s.any_rotating, s.rest_overlaps,
           s.cache.spin_known, s.cache.spin_bonded, s.cache.bonded_particles,
-          s.cache.bonds_partial, s.cache.bond_moments_zero, s.cache.bond_records_with_moments,
-          s.ctx, ledger_if_tracked(s)};
+          s.cache.bonds_partial, s.cache.bond_moments_zero, s.cache.bond_ends_turn,
+          s.cache.bond_records, s.ctx, ledger_if_tracked(s)};
 }
 
 WallStageView wall_view(State& s) {
@@ -468,7 +476,7 @@ GroupStageView group_view(State& s) {
 
 IntegrateStageView integrate_view(State& s) {
   return {s.p, s.pairs, s.incidence, s.walls.contacts, s.bonds, s.cache.bond_incidence,
-          s.cache.bond_records_with_moments, s.cache.idle, s.cache.block_free,
+          s.cache.bond_records, s.cache.idle, s.cache.block_free,
           s.cache.block_busy, s.cache.spin_known, s.cache.spin_reachable, s.cache.spin_bonded,
           s.settings.gravity, s.settings.local_damping, s.dt, s.any_rotating, s.ctx};
 }
@@ -479,6 +487,11 @@ void step_once(State& s) {
   if (rebuilt) build_neighbors(s);
   const bool estimate_due = s.step >= s.last_estimate_step + std::uint64_t(s.settings.dt_interval);
   if (!s.cache.idle_valid) split_idle(s);
+  if (!s.cache.bond_ends_turn_known) {
+    s.cache.bond_ends_turn = std::any_of(s.cache.bonded_particles.begin(), s.cache.bonded_particles.end(),
+                                         [&](std::int32_t i) { return particle_turns(s, std::size_t(i)); });
+    s.cache.bond_ends_turn_known = true;
+  }
   if (rebuilt || estimate_due || s.dt <= 0) check_dt(s);
   // The three force stages, then gather + integrate, in one parallel region (step_context.hpp,
   // StageLoop); the ledgers and wall forces are summed after it.

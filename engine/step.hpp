@@ -20,6 +20,10 @@ struct OverlapRatio {
   std::int64_t particle = -1;
 };
 OverlapRatio deepest_overlap(const State& s, bool turning_only = false);
+// The torque particle i's bonds gave it in the last step that the gather left out (records of
+// kernels::BondRecord::forces: it does not turn), from the bonds as the step left them; zero
+// where the records held it.
+Vec3 bond_torque_left_out(const State& s, std::size_t i);
 Energies compute_energies(const State& s);
 void watch_load(State& s);  // StepContext::load_limit, for automatic threads
 

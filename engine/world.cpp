@@ -133,7 +133,7 @@ Vec3 World::force(std::int64_t id) const {
 Vec3 World::torque(std::int64_t id) const {
   const auto& p = state_->p;
   const auto i = index_of(*state_, id);
-  return ASPERITY_VEC(t);
+  return ASPERITY_VEC(t) + detail::bond_torque_left_out(*state_, i);
 }
 #undef ASPERITY_VEC
 double World::radius(std::int64_t id) const { return state_->p.radius[index_of(*state_, id)]; }

@@ -197,7 +197,12 @@ void World::set_group_applied_force(int group, Vec3 f) {
   state_->groups[check_group(*state_, group)].applied = f;
 }
 Vec3 World::group_force(int group) const { return state_->groups[check_group(*state_, group)].force; }
-Vec3 World::group_torque(int group) const { return state_->groups[check_group(*state_, group)].torque; }
+Vec3 World::group_torque(int group) const {
+  const auto& grp = state_->groups[check_group(*state_, group)];
+  Vec3 t = grp.torque;
+  for (const std::int32_t i : grp.members) t += detail::bond_torque_left_out(*state_, std::size_t(i));
+  return t;
+}
 Vec3 World::group_position(int group) const { return state_->groups[check_group(*state_, group)].centre; }
 Vec3 World::group_impulse(int group) const { return state_->groups[check_group(*state_, group)].impulse; }
 Vec3 World::group_velocity(int group) const { return state_->groups[check_group(*state_, group)].velocity; }

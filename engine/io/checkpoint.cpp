@@ -30,7 +30,7 @@ namespace asperity {
 namespace {
 
 using detail::State;
-constexpr int kCheckpointVersion = 12;  // 2: servo integral and integral time, group damping;
+constexpr int kCheckpointVersion = 13;  // 2: servo integral and integral time, group damping;
                                        // 3: rest overlaps (stress-free bonds);
                                        // 4: meshes' candidates within half the skin;
                                        // 5: a header with a checksum in the HDF5 user block;
@@ -42,7 +42,9 @@ constexpr int kCheckpointVersion = 12;  // 2: servo integral and integral time, 
                                        // 10: the groups' impulse (a resumed run's interval means);
                                        // 11: the lazy groups' idle split and pending shift, so that
                                        //     saving does not bring idle members up to date;
-                                       // 12: rotation_lock_beams
+                                       // 12: rotation_lock_beams;
+                                       // 13: the bond records' layout (4, 8 or 12 doubles), for
+                                       //     the torque's terms World::torque adds
 
 // The file's kind in the header of its HDF5 user block (io::h5::file_image), whose checksum is
 // verified before HDF5 parses the file: HDF5 does not survive every corruption of its metadata.
@@ -353,7 +355,19 @@ void visit(Io& io, State& s) {
     io.scalar("run/spin_reachable", s.cache.spin_reachable);
     io.scalar("run/spin_bonded", s.cache.spin_bonded);
     io.flag("run/bond_moments_zero", s.cache.bond_moments_zero);
-    io.flag("run/bond_records_with_moments", s.cache.bond_records_with_moments);
+    // The layout the last bond stage wrote (Caches::bond_records); before version 13 a flag, with
+    // the moment or without.
+    if (io.version >= 13) {
+      auto width = std::uint8_t(s.cache.bond_records);
+      io.scalar("run/bond_records", width);
+      if (width != 4 && width != 8 && width != 12)
+        throw Error("checkpoint: run/bond_records is " + std::to_string(width) + ", not 4, 8 or 12");
+      s.cache.bond_records = kernels::BondRecord(width);
+    } else {
+      bool moments = s.cache.bond_records == kernels::BondRecord::moments;
+      io.flag("run/bond_records_with_moments", moments);
+      s.cache.bond_records = moments ? kernels::BondRecord::moments : kernels::BondRecord::levers;
+    }
     io.flag("run/pair_records_sparse", s.cache.pair_records_sparse);
   }
   io.count("groups/n", s.groups);
@@ -628,7 +642,7 @@ World World::load(const std::string& path, int threads, const std::string& simd)
       s.cache.spin_reachable = c.spin_reachable;
       s.cache.spin_bonded = c.spin_bonded;
       s.cache.bond_moments_zero = c.bond_moments_zero;
-      s.cache.bond_records_with_moments = c.bond_records_with_moments;
+      s.cache.bond_records = c.bond_records;
       s.cache.pair_records_sparse = c.pair_records_sparse;
     }
   }

@@ -10,9 +10,11 @@ namespace asperity::kernels {
 
 // Moments = false (with Rotation = false): the beams carry no moment (bond_law.hpp); their four
 // columns are neither read nor written, and the record is the first eight values only (its
-// moment would be +-0), eight doubles a bond.
-template <class Lanes, bool Rotation, bool Moments = true>
+// moment would be +-0), eight doubles a bond. Levers = false (with Moments = false): no end of a
+// bond turns, and the record is the first four (BondRecord::forces).
+template <class Lanes, bool Rotation, bool Moments = true, bool Levers = true>
 BondSums bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) {
+  static_assert(Levers || !Moments, "a beam moment acts where the ends turn");
   using T = typename Lanes::Real;
   const BondParams<T> p{T(k.kn), T(k.ks), T(k.beam_kn), T(k.beam_ks), T(k.dt), T(k.strength)};
   const LawParams<T> contact{T(k.kn), T(k.ks), T(k.friction), T(k.dt)};  // once the contact bond broke
@@ -105,8 +107,8 @@ BondSums bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) 
     // record fx fy fz U cx cy cz 0 mx my mz 0 of each bond (store/bonds.hpp).
     const T ftot = fn + s.fbn;
     const T sx = s.fsx + s.fbsx, sy = s.fsy + s.fbsy, sz = s.fsz + s.fbsz;
-    // Without moments only the first eight values are stored.
-    constexpr int width = Moments ? 12 : 8;
+    // Without moments only the first eight values are stored, without levers the first four.
+    constexpr int width = int(Moments ? BondRecord::moments : Levers ? BondRecord::levers : BondRecord::forces);
     const T record[12] = {ftot * nx + sx, ftot * ny + sy, ftot * nz + sz, U,
                           ny * sz - nz * sy, nz * sx - nx * sz, nx * sy - ny * sx, T(0.0),
                           s.mbn * nx + s.mbsx, s.mbn * ny + s.mbsy, s.mbn * nz + s.mbsz, T(0.0)};

@@ -18,6 +18,7 @@ KernelSet loop_kernels(const char* name, GatherKernel gather) {
           &bond_loop<Lanes, true>,
           &bond_loop<Lanes, false>,
           &bond_loop<Lanes, false, false>,
+          &bond_loop<Lanes, false, false, false>,
           &integrate_loop<Lanes, true>,
           &integrate_loop<Lanes, false>,
           &plane_wall_loop<Lanes, true>,

@@ -72,7 +72,8 @@ struct BondKernelArgs {
   double* broken;
   // Output for the gather (store/bonds.hpp): per bond the record fx fy fz U cx cy cz 0 mx my mz 0,
   // twelve doubles from out + 12 k (32-byte aligned); the kernel without moments writes the first
-  // eight only, from out + 8 k.
+  // eight only, from out + 8 k, and the one for bonds no end of which turns the first four, from
+  // out + 4 k (BondRecord).
   double* out;
   double kn, ks, beam_kn, beam_ks, dt, strength;
   std::size_t columns = 0;  // as PairKernelArgs::columns
@@ -85,6 +86,20 @@ struct BondKernelArgs {
   double contact_strength = 0;
   double contact_shear_strength = 0;  // cs of its shear strength cs st A (0: cs = c)
   double contact_bond_friction = 0;   // mu_b: + mu_b Fn under compression
+};
+
+// What a bond record holds (store/bonds.hpp), as many doubles as its value: the layout the bond
+// kernel that wrote it gives, and the gather reads.
+enum class BondRecord : std::uint8_t {
+  // fx fy fz U cx cy cz 0 mx my mz 0: the force on b, the overlap, n x Fs and the beam's moment.
+  moments = 12,
+  // fx fy fz U cx cy cz 0: every beam moment zero (no spin ever grew one), left out.
+  levers = 8,
+  // fx fy fz U: besides, no end of a bond turns (model.md 2 locks a bonded particle; a rigid
+  // group's member turns with its group), so the torque of the bonds' shear forces moves nothing
+  // and is not gathered: a bonded specimen's record is half a cache line (World::torque adds
+  // those terms when asked).
+  forces = 4,
 };
 
 struct BondSums {
@@ -127,13 +142,13 @@ using PlaneWallKernel = void (*)(const PlaneWallArgs&, std::size_t begin, std::s
 // - the sum of the force and torque the pair records give it (store/pairs.hpp: record
 //   fx fy fz U cx cy cz fn; on b: +F, on a: -F; on either: -(R - U/2) n x Fs);
 // - then, where a bond list is given, the same from the bond records (store/bonds.hpp) plus the
-//   beam moment (+M on b, -M on a), added to those sums;
+//   beam moment (+M on b, -M on a), added to those sums (the terms its BondRecord holds);
 // written to fx..tz[i] (the pairs' arguments name the columns). The walls and applied forces are
 // added by the caller (stages/integrate.cpp).
 struct GatherArgs {
   const std::int32_t* start;  // incidence CSR (store/pairs.hpp, Incidence)
   const std::int64_t* entry;  // (pair or bond << 1) | (particle is b)
-  const double* records;      // 8 doubles per pair, 12 per bond
+  const double* records;      // 8 doubles per pair, 4, 8 or 12 per bond (BondRecord)
   const double* radius;
   const std::uint8_t* inert; const std::uint8_t* idle;
   double* fx; double* fy; double* fz;
@@ -148,10 +163,9 @@ struct GatherArgs {
   // +-0 (it never becomes -0 in round-to-nearest), with the lever R - U/2 finite for U <= 0.
   // Null: every record is read.
   const std::uint8_t* live = nullptr;
-  // Bond lists: false where the bond kernel without moments wrote the records (every beam moment
-  // zero: State::bond_moments_zero): 8 doubles a bond without the moment, whose terms the gather
-  // then leaves out; true: 12 with it.
-  bool moments = true;
+  // Bond lists: the layout the bond kernel wrote (BondRecord); the gather leaves out the terms
+  // the record does not hold.
+  BondRecord bond_record = BondRecord::moments;
 };
 
 using GatherKernel = void (*)(const GatherArgs& pairs, const GatherArgs* bonds, std::size_t begin,
@@ -195,6 +209,7 @@ struct KernelSet {
   BondKernel bond_norot;
   BondKernel bond_no_moment;  // no spin and no beam moment (bond_loop.hpp): the moments untouched,
                               // records of 8 doubles (no moment)
+  BondKernel bond_forces;     // the same, for bonds no end of which turns: records of 4 (BondRecord)
   IntegrateKernel integrate;        // with rotation
   IntegrateKernel integrate_norot;  // no particle can rotate: w and torques are not read
   PlaneWallKernel plane_walls;       // with rotation

@@ -69,6 +69,7 @@ void refresh_bond_topology(State& s) {
   s.frozen_bonds.fill_padding(p.null_a(), p.null_b());
   ++s.bond_version;
   s.cache.spin_known = false;  // the bonded particles changed (State::spin_known)
+  s.cache.bond_ends_turn_known = false;  // and their locks
   // The gather's incidence: the bonds the step computes. Partners and rotation locks: every bond
   // (a frozen one still ties its particles).
   build_incidence(p.n, q.a.data(), q.b.data(), q.n, s.cache.bond_incidence);
@@ -136,8 +137,12 @@ void refresh_bond_topology_after_breaks(State& s, const BondLosses& losses) {
   // A break only frees particles (fewer intact bonds, as many installed): any_rotating can only
   // become true, and only the ends of the broken bonds can change.
   for (const auto* ends : {&losses.gone_ends, &losses.beam_ends})
-    for (const auto i : *ends)
-      s.any_rotating = !set_lock(s, std::size_t(i), listed_partners(c, std::size_t(i))) || s.any_rotating;
+    for (const auto i : *ends) {
+      const auto k = std::size_t(i);
+      s.any_rotating = !set_lock(s, k, listed_partners(c, k)) || s.any_rotating;
+      // An end freed while it still holds a bond the step computes: its records need the levers.
+      if (c.bond_incidence.start[k + 1] > c.bond_incidence.start[k] && particle_turns(s, k)) c.bond_ends_turn = true;
+    }
 }
 
 }  // namespace asperity::detail

@@ -48,11 +48,19 @@ StageLoop bond_stage(const BondStageView& s) {
   // Without spin no moment grows: while every beam moment is zero (a bonded specimen whose
   // particles never turned: the joints) the kernel leaves the four moment columns alone and its
   // records carry no moment, memory traffic saved at every step. A step with spin may give them
-  // values.
-  const auto kernel = spin ? s.ctx.kernels->bond
-                           : (s.moments_zero ? s.ctx.kernels->bond_no_moment : s.ctx.kernels->bond_norot);
+  // values. Where besides no end of a bond turns (the thesis's rotation rule locks every bonded
+  // particle; the joint's platens do not turn), nothing the records' torque terms would give
+  // moves a particle: records of four, half the bond records' traffic.
+  using kernels::BondRecord;
+  const auto& ks = *s.ctx.kernels;
+  const auto kernel = spin ? ks.bond
+                           : !s.moments_zero ? ks.bond_norot
+                           : s.ends_turn     ? ks.bond_no_moment
+                                             : ks.bond_forces;
   if (spin) s.moments_zero = false;
-  s.records_with_moments = kernel != s.ctx.kernels->bond_no_moment;
+  s.records = kernel == ks.bond_forces      ? BondRecord::forces
+              : kernel == ks.bond_no_moment ? BondRecord::levers
+                                            : BondRecord::moments;
   const std::size_t total = s.bonds.padded;
   const std::size_t block = pair_block_size(total);
   st.blocks = (total + block - 1) / block;

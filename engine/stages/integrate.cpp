@@ -60,7 +60,7 @@ StageLoop integrate_stage(const IntegrateStageView& s) {
   bond_args.start = binc.start.data();
   bond_args.entry = binc.entry.data();
   bond_args.records = bq.out.data();
-  bond_args.moments = s.bond_records_with_moments;
+  bond_args.bond_record = s.bond_records;
   // Records past the caches are prefetched a few particles ahead, as the incidences reach their
   // lines out of order; records in cache are not (the prefetches would cost and hide nothing).
   pair_args.prefetch = records_past_caches(q.out);

@@ -44,7 +44,8 @@ struct BondStageView {
   const std::vector<std::int32_t>& bonded_particles;
   bool bonds_partial;          // Caches::bonds_partial: read what holds of each bond
   bool& moments_zero;          // Caches::bond_moments_zero: cleared by a step with spin
-  bool& records_with_moments;  // Caches::bond_records_with_moments: the layout written
+  bool ends_turn;              // Caches::bond_ends_turn: the records carry the levers
+  kernels::BondRecord& records;  // Caches::bond_records: the layout written
   StepContext& ctx;            // the kernels; per-block breaks and slip
   Ledger* ledger;              // friction of contact springs whose contact bond broke; or null
 };
@@ -67,7 +68,7 @@ struct IntegrateStageView {
   const WallContacts& wall_contacts;
   const BondStore& bonds;
   const Incidence& bond_incidence;
-  bool bond_records_with_moments;  // the layout the bond stage wrote
+  kernels::BondRecord bond_records;  // the layout the bond stage wrote
   // The idle split of rigid groups (Caches::idle, block_free, block_busy).
   const std::vector<std::uint8_t>& idle;
   const std::vector<std::uint8_t>& block_free;

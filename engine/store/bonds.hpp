@@ -50,7 +50,8 @@ struct BondStore {
   // force on b (fn + fbn) n + fs + fbs, the overlap, n x (fs + fbs) (torque per lever arm,
   // negated) and the beam moment on b mbn n + mbs (on a: its negative). While every moment is zero
   // the kernel without moments writes records of 8 (the first eight values, from out + 8 k: one
-  // 64-byte line a bond instead of 1.5; State::bond_records_with_moments says which).
+  // 64-byte line a bond instead of 1.5), and where besides no end of a bond turns, records of 4
+  // (from out + 4 k); Caches::bond_records says which (kernels::BondRecord).
   AVec<double> out;
   BondMaterial material;
   bool any = false;                       // a material was set by a first installation

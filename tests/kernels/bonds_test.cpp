@@ -861,7 +861,8 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
     hist[27][k] = (k % 3 == 0) ? 0.01 * r[ia] * u(rng) : 0.0;  // rest overlaps, stress-free bonds
     hist[28][k] = double(1 + k % 3);  // beam only, contact bond only, both (BondStore::holds)
   }
-  // kernel: 0 the full law, 1 without spin, 2 without spin and beam moments. partial: bonds that
+  // kernel: 0 the full law, 1 without spin, 2 without spin and beam moments, 3 the same for bonds
+  // no end of which turns (records of the forces only). partial: bonds that
   // lost their beam or their contact bond, contact bonds of strength 2 st A (else every bond
   // holds both, and the contact bond breaks with the beam).
   auto run = [&](const kernels::KernelSet& ks, std::vector<AVec<double>> h, bool rest,
@@ -882,16 +883,20 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
       args.contact_bond_friction = 0.3;
     }
     // The gather's records (store/bonds.hpp): every slot written, the pads with 0; records of 8
-    // (no moment) from the kernel without moments, whose slots beyond them stay untouched.
-    const std::size_t width = kernel == 2 ? 8 : 12;
+    // (no moment) from the kernel without moments and of 4 (force and overlap) from the one for
+    // bonds whose ends do not turn, whose slots beyond them stay untouched.
+    const std::size_t width = kernel == 3 ? 4 : kernel == 2 ? 8 : 12;
     AVec<double> records(12 * bonds, -7.0);
     args.out = records.data();
-    const kernels::BondSums broken = (kernel == 0 ? ks.bond : kernel == 1 ? ks.bond_norot : ks.bond_no_moment)(args, 0, bonds);
+    const kernels::BondKernel kernels[] = {ks.bond, ks.bond_norot, ks.bond_no_moment, ks.bond_forces};
+    const kernels::BondSums broken = kernels[kernel](args, 0, bonds);
     // Record column j as a column of its own (18 + j for the force, overlap and n x Fs, then
     // the moment: -1 where the record has none), so the comparisons below see them.
     for (std::size_t k = 0; k < bonds; ++k) {
-      for (int j = 0; j < 7; ++j) h[18 + j][k] = records[width * k + std::size_t(j)];
-      EXPECT_EQ(records[width * k + 7], 0.0);
+      for (std::size_t j = 0; j < 7; ++j) h[18 + j][k] = j < width ? records[width * k + j] : -1.0;
+      if (width > 4) {
+        EXPECT_EQ(records[width * k + 7], 0.0);
+      }
       if (width == 12) {
         h[25][k] = records[12 * k + 8];
         h[26][k] = records[12 * k + 10];
@@ -901,8 +906,8 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
         h[25][k] = h[26][k] = h[16][k] = -1.0;
       }
     }
-    if (width == 8) {
-      EXPECT_EQ(records[8 * bonds], -7.0) << "records of 8: nothing written beyond them";
+    if (width < 12) {
+      EXPECT_EQ(records[width * bonds], -7.0) << "records of " << width << ": nothing written beyond them";
     }
     return std::make_pair(broken, h);
   };
@@ -969,6 +974,25 @@ TEST_P(SimdBondKernel, EqualsTheScalarReferenceBitwise) {
           ASSERT_EQ(carried.second[c][k], 0.0) << arch << " column " << c << " bond " << k;
       } else {
         EXPECT_EQ(0, std::memcmp(got.data(), carried.second[c].data(), bonds * sizeof(double)))
+            << arch << " column " << c;
+      }
+    }
+  }
+  // Where besides no end of a bond turns (BondRecord::forces): the same bits as the kernel
+  // without moments in every column and in the criterion, the records' n x Fs left out. Its SIMD
+  // forms equal its scalar reference.
+  const auto forces_ref = run(kernels::scalar_kernels(), hist, true, 3);
+  for (const auto& arch : available_simd_architectures()) {
+    const auto& ks = kernels::select_kernels(arch);
+    const auto levers = run(ks, hist, true, 2), forces = run(ks, hist, true, 3);
+    EXPECT_EQ(levers.first.breaks, forces.first.breaks) << arch;
+    for (int c = 0; c < 29; ++c) {
+      EXPECT_EQ(0, std::memcmp(forces.second[c].data(), forces_ref.second[c].data(), bonds * sizeof(double)))
+          << arch << " column " << c << " against the scalar reference";
+      if (c >= 22 && c <= 24) {  // n x Fs: none in records of 4
+        for (std::size_t k = 0; k < bonds; ++k) ASSERT_EQ(forces.second[c][k], -1.0) << arch << " column " << c;
+      } else {
+        EXPECT_EQ(0, std::memcmp(forces.second[c].data(), levers.second[c].data(), bonds * sizeof(double)))
             << arch << " column " << c;
       }
     }
@@ -1057,6 +1081,91 @@ TEST(Bonds, BreakStepsLeaveTheTopologyAFullRefreshBuilds) {
     EXPECT_EQ(some_partial, rule.c != 0.0) << "contact bonds and beams break apart, unless together";
     EXPECT_TRUE(some_freed) << "damage frees particles";
   }
+}
+
+// Where no end of a bond turns the bond records hold the forces only (kernels::BondRecord::forces)
+// and the gather leaves the torque of the bonds' shear forces out; World::torque and
+// World::group_torque add it when asked. Checked against the torque rebuilt from what
+// world.contacts() and world.bonds() report, -(R - U/2) n x Fs per contact and bond, on every
+// particle away from the walls of a bonded box; the gathered column alone misses it.
+TEST(Bonds, TheTorqueOfAParticleThatDoesNotTurnHoldsItsBondsShear) {
+  WorldSettings ws;
+  World w = test::bonded_box(ws, false);
+  w.cycle(300);
+  const detail::State& s = w.state();
+  ASSERT_EQ(s.cache.bond_records, kernels::BondRecord::forces) << "every bonded particle is locked";
+  std::vector<Vec3> rebuilt(w.particle_count(), Vec3{0, 0, 0});
+  std::vector<double> scale(w.particle_count(), 0.0);
+  auto add = [&](std::int64_t id, const Vec3& n, double U, const Vec3& fs) {
+    const Vec3 t = cross(n, fs) * -(w.radius(id) - 0.5 * U);
+    rebuilt[std::size_t(id)] += t;
+    scale[std::size_t(id)] += norm(t);
+  };
+  for (const ContactInfo& c : w.contacts()) {
+    add(c.id_a, c.normal, c.overlap, c.shear_force);
+    add(c.id_b, c.normal, c.overlap, c.shear_force);
+  }
+  std::vector<int> bonded(w.particle_count(), 0);
+  for (const BondInfo& b : w.bonds()) {
+    ASSERT_EQ(b.twisting_moment, 0.0);
+    add(b.id_a, b.normal, -b.gap, b.shear_force);
+    add(b.id_b, b.normal, -b.gap, b.shear_force);
+    ++bonded[std::size_t(b.id_a)], ++bonded[std::size_t(b.id_b)];
+  }
+  const double L = 12e-3;  // test::random_box's walls: x, y in [0, L], z above 0
+  std::size_t checked = 0, missed = 0;
+  for (std::size_t id = 0; id < w.particle_count(); ++id) {
+    const Vec3 x = w.position(std::int64_t(id));
+    const double r = w.radius(std::int64_t(id));
+    if (!bonded[id] || x.x < r || x.y < r || x.z < r || x.x > L - r || x.y > L - r) continue;
+    const Vec3 t = w.torque(std::int64_t(id));
+    ASSERT_LE(norm(t - rebuilt[id]), 1e-12 * scale[id]) << "particle " << id;
+    const std::size_t i = std::size_t(s.p.index_of_id[id]);
+    missed += norm(Vec3{s.p.tx[i], s.p.ty[i], s.p.tz[i]} - rebuilt[id]) > 1e-3 * scale[id];
+    ++checked;
+  }
+  EXPECT_GT(checked, 200u);  // 284 of the 600
+  EXPECT_GT(missed, checked / 2) << "the gathered column alone leaves the bonds' terms out";
+  // A rigid group of fixed rotation does not turn either; its torque about its centre holds its
+  // members' bonds' terms too: sum (t_i + r_i x f_i) over its members, rebuilt as above.
+  std::vector<std::int64_t> members;
+  for (std::size_t id = 0; id < w.particle_count() && members.size() < 40; ++id) {
+    const Vec3 x = w.position(std::int64_t(id));
+    const double r = w.radius(std::int64_t(id));
+    if (bonded[id] && x.z > 2e-3 && x.x > r && x.y > r && x.x < L - r && x.y < L - r) members.push_back(std::int64_t(id));
+  }
+  ASSERT_GE(members.size(), 20u);
+  GroupMotion held;
+  held.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
+  held.rotation = Dof::fixed;
+  const int g = w.add_group(members, held);
+  w.cycle(20);
+  ASSERT_EQ(s.cache.bond_records, kernels::BondRecord::forces);
+  Vec3 expected{0, 0, 0};
+  double total = 0;
+  const std::vector<BondInfo> bonds = w.bonds();
+  const std::vector<ContactInfo> contacts = w.contacts();
+  // Bonds and contacts between members are left out: the step leaves them out (frozen bonds,
+  // State::frozen_bonds), their forces cancelling within the body.
+  auto member = [&](std::int64_t id) { return std::find(members.begin(), members.end(), id) != members.end(); };
+  for (const std::int64_t id : members) {
+    Vec3 t{0, 0, 0};
+    for (const ContactInfo& c : contacts)
+      if ((c.id_a == id || c.id_b == id) && !(member(c.id_a) && member(c.id_b)))
+        t += cross(c.normal, c.shear_force) * -(w.radius(id) - 0.5 * c.overlap);
+    for (const BondInfo& b : bonds)
+      if ((b.id_a == id || b.id_b == id) && !(member(b.id_a) && member(b.id_b)))
+        t += cross(b.normal, b.shear_force) * -(w.radius(id) + 0.5 * b.gap);
+    expected += t + cross(w.position(id) - w.group_position(g), w.force(id));
+    total += norm(t) + norm(cross(w.position(id) - w.group_position(g), w.force(id)));
+  }
+  EXPECT_LE(norm(w.group_torque(g) - expected), 1e-12 * total);
+  EXPECT_GT(norm(s.groups[std::size_t(g)].torque - expected), 1e-6 * total) << "the gathered sum alone misses them";
+  // A particle that turns (here: bonded rotation unlocked) needs the levers in the records.
+  ws.lock_bonded_rotation = false;
+  World turning = test::bonded_box(ws, false);
+  turning.cycle(10);
+  EXPECT_NE(turning.state().cache.bond_records, kernels::BondRecord::forces);
 }
 
 // A bond material is checked field by field against its table (materials.hpp) before anything

@@ -585,7 +585,8 @@ TEST(KernelEquivalence, SimdGatherEqualsTheScalarReferenceBitwise) {
     idle[i] = i % 13 == 0;
   }
   using Columns = std::array<std::vector<double>, 6>;  // fx fy fz tx ty tz
-  auto run = [&](const kernels::KernelSet& ks, bool with_bonds, const List& bonds, bool moments = true) {
+  auto run = [&](const kernels::KernelSet& ks, bool with_bonds, const List& bonds,
+                 kernels::BondRecord layout = kernels::BondRecord::moments) {
     Columns o;
     for (auto& c : o) c.assign(n, -7.0);
     kernels::GatherArgs g{pairs.inc.start.data(), pairs.inc.entry.data(), pairs.records.data(),
@@ -595,7 +596,7 @@ TEST(KernelEquivalence, SimdGatherEqualsTheScalarReferenceBitwise) {
     gb.start = bonds.inc.start.data();
     gb.entry = bonds.inc.entry.data();
     gb.records = bonds.records.data();
-    gb.moments = moments;
+    gb.bond_record = layout;
     for (auto [first, end] : {std::pair<std::size_t, std::size_t>{0, 400}, {400, n}}) {  // two blocks
       ks.gather(g, with_bonds ? &gb : nullptr, first, end);
     }
@@ -606,16 +607,24 @@ TEST(KernelEquivalence, SimdGatherEqualsTheScalarReferenceBitwise) {
   // Bonds whose beams carry no moment (State::bond_moments_zero): the kernel without moments
   // writes records of 8, without the moment, and the gather leaves its terms out; the sums are
   // those of the records of 12 with a zero moment (the sign of an exact zero sum aside).
-  List unbent = bonds, unbent8 = bonds;
+  // Where besides no end of a bond turns, the kernel writes records of 4 (BondRecord::forces):
+  // the forces are those of the records of 12, the torques the pairs' alone.
+  List unbent = bonds, unbent8 = bonds, unbent4 = bonds;
   unbent8.records.assign(8 * count, 0.0);
+  unbent4.records.assign(4 * count, 0.0);
   for (std::size_t k = 0; k < count; ++k) {
     for (std::size_t j = 8; j < 11; ++j) unbent.records[12 * k + j] = 0.0;
     for (std::size_t j = 0; j < 7; ++j) unbent8.records[8 * k + j] = bonds.records[12 * k + j];
+    for (std::size_t j = 0; j < 4; ++j) unbent4.records[4 * k + j] = bonds.records[12 * k + j];
   }
   const Columns ref_unbent = run(kernels::scalar_kernels(), true, unbent);
-  const Columns ref_unbent_cut = run(kernels::scalar_kernels(), true, unbent8, false);
+  const Columns ref_unbent_cut = run(kernels::scalar_kernels(), true, unbent8, kernels::BondRecord::levers);
+  const Columns ref_forces = run(kernels::scalar_kernels(), true, unbent4, kernels::BondRecord::forces);
   for (int c = 0; c < 6; ++c)
-    for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(ref_unbent[c][i], ref_unbent_cut[c][i]) << c << " " << i;
+    for (std::size_t i = 0; i < n; ++i) {
+      ASSERT_EQ(ref_unbent[c][i], ref_unbent_cut[c][i]) << c << " " << i;
+      ASSERT_EQ(c < 3 ? ref_unbent[c][i] : ref_pairs[c][i], ref_forces[c][i]) << "forces only: " << c << " " << i;
+    }
   EXPECT_NE(0, std::memcmp(ref_unbent[5].data(), ref[5].data(), n * sizeof(double)))
       << "the moments do reach the torques";
   std::size_t checked = 0;
@@ -651,7 +660,8 @@ TEST(KernelEquivalence, SimdGatherEqualsTheScalarReferenceBitwise) {
   for (const auto& arch : available_simd_architectures()) {
     const Columns got = run(kernels::select_kernels(arch), true, bonds);
     const Columns got_pairs = run(kernels::select_kernels(arch), false, bonds);
-    const Columns got_unbent_cut = run(kernels::select_kernels(arch), true, unbent8, false);
+    const Columns got_unbent_cut = run(kernels::select_kernels(arch), true, unbent8, kernels::BondRecord::levers);
+    const Columns got_forces = run(kernels::select_kernels(arch), true, unbent4, kernels::BondRecord::forces);
     for (int c = 0; c < 6; ++c) {
       EXPECT_EQ(0, std::memcmp(ref[c].data(), got[c].data(), n * sizeof(double)))
           << arch << " column " << c;
@@ -659,6 +669,8 @@ TEST(KernelEquivalence, SimdGatherEqualsTheScalarReferenceBitwise) {
           << arch << " pairs alone, column " << c;
       EXPECT_EQ(0, std::memcmp(ref_unbent_cut[c].data(), got_unbent_cut[c].data(), n * sizeof(double)))
           << arch << " bonds without moments, column " << c;
+      EXPECT_EQ(0, std::memcmp(ref_forces[c].data(), got_forces[c].data(), n * sizeof(double)))
+          << arch << " bonds' forces only, column " << c;
     }
   }
 }
