@@ -397,6 +397,9 @@ class World {
   Vec3 velocity(std::int64_t id) const;          // at the last half step (leapfrog)
   Vec3 angular_velocity(std::int64_t id) const;
   Vec3 force(std::int64_t id) const;             // contact + applied force of the last step
+  // Torque of the last step. On a particle that does not turn, its bonds' share is computed when
+  // asked (the step leaves it out: kernels::BondRecord), from the bonds as the step left them: a
+  // bond that broke in that step no longer counts.
   Vec3 torque(std::int64_t id) const;
   double radius(std::int64_t id) const;
   double mass(std::int64_t id) const;
