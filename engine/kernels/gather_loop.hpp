@@ -27,11 +27,12 @@ inline bool skips_record(const GatherArgs& g, std::int64_t entry) {
   return g.live && !g.live[std::size_t(entry >> 1)];
 }
 
-// Bonds = false: the pair list (records of 8); true: the bond list, in the layout R (BondRecord):
-// with the beam's moment, which acts on b and its negative on a; without (every moment zero:
-// t - lever C is what t + (s 0 - lever C) gives); or forces only (no end turns: no torque term).
-template <bool Bonds, BondRecord R = BondRecord::moments>
-inline constexpr std::size_t record_width = Bonds ? std::size_t(R) : 8;
+// Bonds = false: the pair list (records of 8); true: the bond list, in the layout Layout
+// (BondRecord): with the beam's moment, which acts on b and its negative on a; without (every
+// moment zero: t - lever C is what t + (s 0 - lever C) gives); or forces only (no end turns: no
+// torque term).
+template <bool Bonds, BondRecord Layout = BondRecord::moments>
+inline constexpr std::size_t record_width = Bonds ? std::size_t(Layout) : 8;
 
 template <bool Bonds, BondRecord Layout = BondRecord::moments>
 inline void add_incidences_scalar(const GatherArgs& g, std::size_t i, double R, double f[3],
