@@ -1021,6 +1021,57 @@ TEST(Bonds, BondedBlockIsDeterministicAcrossThreadsAndSurvivesReorders) {
   }
 }
 
+// Under the thesis's rotation rule (model.md 2) no particle holding a bond turns, so no beam takes
+// a moment, and the beam's stiffness is a force stiffness (kbn A, BondMaterial::beam_kn) that
+// does not depend on its radius: lambda enters only the periphery stresses [3-27], force / A, and
+// the elliptic criterion [3-46..3-49] and the contact bond's c st A scale with st. So lambda and
+// st act only as st lambda^2: lambda halved and st four times (both exact in binary) give the same
+// run bit for bit, breaks of both kinds included, and stresses four times as large. (With the
+// rotation lock off the beams take moments, I = pi Rb^4 / 4, and lambda is a parameter of its own.)
+TEST(Bonds, UnderTheRotationLockTheBondRadiusOnlyRescalesTheStrength) {
+  struct Run {
+    std::vector<double> positions;
+    std::vector<BreakEvent> breaks;
+  };
+  auto run = [](double lambda, double st, bool lock) {
+    WorldSettings ws;
+    ws.dt = 5e-4;
+    ws.lock_bonded_rotation = lock;
+    World w = test::random_box(600, ws);
+    w.cycle(3000);  // settle
+    BondMaterial bm;
+    bm.radius_factor = lambda;
+    bm.tensile_strength = st;
+    bm.contact_strength = 1.5;
+    w.install_bonds(bm, 2e-5, {}, false);
+    w.cycle(2000);
+    return Run{w.positions(), w.break_events()};
+  };
+  const double st = 0.03;
+  const Run one = run(1.0, st, true), half = run(0.5, 4 * st, true);
+  ASSERT_EQ(one.positions.size(), half.positions.size());
+  EXPECT_EQ(0, std::memcmp(one.positions.data(), half.positions.data(), one.positions.size() * sizeof(double)));
+  ASSERT_EQ(one.breaks.size(), half.breaks.size());
+  std::size_t beams = 0, contact_bonds = 0;
+  for (std::size_t k = 0; k < one.breaks.size(); ++k) {
+    const BreakEvent &a = one.breaks[k], &b = half.breaks[k];
+    EXPECT_EQ(a.step, b.step);
+    EXPECT_EQ(a.id_a, b.id_a);
+    EXPECT_EQ(a.id_b, b.id_b);
+    EXPECT_EQ(a.kind, b.kind);
+    EXPECT_EQ(a.mode, b.mode);
+    EXPECT_EQ(4 * a.sigma, b.sigma);
+    EXPECT_EQ(4 * a.tau, b.tau);
+    (a.kind == BreakEvent::Kind::beam ? beams : contact_bonds) += 1;
+  }
+  EXPECT_GT(beams, 10u) << "the criterion must be exercised";
+  EXPECT_GT(contact_bonds, 0u);
+  // Where particles holding bonds turn, the same change is another material.
+  const Run free_one = run(1.0, st, false), free_half = run(0.5, 4 * st, false);
+  EXPECT_NE(0, std::memcmp(free_one.positions.data(), free_half.positions.data(),
+                           free_one.positions.size() * sizeof(double)));
+}
+
 // A break step brings the topology up to date in what it changed only
 // (refresh_bond_topology_after_breaks): after steps of breaks of every kind (bonds gone whole,
 // contact bonds and beams apart, particles freed, by each lock rule) it holds what a full
