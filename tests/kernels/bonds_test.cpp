@@ -1026,8 +1026,9 @@ TEST(Bonds, BondedBlockIsDeterministicAcrossThreadsAndSurvivesReorders) {
 // does not depend on its radius: lambda enters only the periphery stresses [3-27], force / A, and
 // the elliptic criterion [3-46..3-49] and the contact bond's c st A scale with st. So lambda and
 // st act only as st lambda^2: lambda halved and st four times (both exact in binary) give the same
-// run bit for bit, breaks of both kinds included, and stresses four times as large. (With the
-// rotation lock off the beams take moments, I = pi Rb^4 / 4, and lambda is a parameter of its own.)
+// run bit for bit, breaks of both kinds included with the energy they release, and stresses four
+// times as large. (With the rotation lock off the beams take moments, I = pi Rb^4 / 4, and lambda
+// is a parameter of its own.)
 TEST(Bonds, UnderTheRotationLockTheBondRadiusOnlyRescalesTheStrength) {
   struct Run {
     std::vector<double> positions;
@@ -1062,6 +1063,7 @@ TEST(Bonds, UnderTheRotationLockTheBondRadiusOnlyRescalesTheStrength) {
     EXPECT_EQ(a.mode, b.mode);
     EXPECT_EQ(4 * a.sigma, b.sigma);
     EXPECT_EQ(4 * a.tau, b.tau);
+    EXPECT_EQ(a.released_energy, b.released_energy);  // force^2 / stiffness: no A in it
     (a.kind == BreakEvent::Kind::beam ? beams : contact_bonds) += 1;
   }
   EXPECT_GT(beams, 10u) << "the criterion must be exercised";
