@@ -130,34 +130,29 @@ struct SimdLanes {
   static void store_records(double* rec, const Real* v) {
     static_assert(Width == 4 || Width == 8 || Width == 12, "records of 4, 8 or 12 values");
 #if defined(__AVX512F__)
-    if constexpr (Width == 4) {
-      // As below for values 0..3: u0 holds items 0 and 4, u1 1 and 5, u2 2 and 6, u3 3 and 7;
-      // the low halves of u0 and u1 are items 0 and 1, one line.
-      const __m512d t0 = _mm512_unpacklo_pd(v[0], v[1]), t1 = _mm512_unpackhi_pd(v[0], v[1]);
-      const __m512d t2 = _mm512_unpacklo_pd(v[2], v[3]), t3 = _mm512_unpackhi_pd(v[2], v[3]);
+    // Four rows of values (r[0..3]) -> q[0] = those values of items 0 and 4, q[1] of items 1 and
+    // 5, q[2] of 2 and 6, q[3] of 3 and 7: rows -> pairs of two-element runs -> half records.
+    auto quarters = [](const Real* r, __m512d (&q)[4]) {
+      const __m512d t0 = _mm512_unpacklo_pd(r[0], r[1]), t1 = _mm512_unpackhi_pd(r[0], r[1]);
+      const __m512d t2 = _mm512_unpacklo_pd(r[2], r[3]), t3 = _mm512_unpackhi_pd(r[2], r[3]);
+      // t0 = r0_0 r1_0 r0_2 r1_2 r0_4 r1_4 r0_6 r1_6 (rj_p: row j of item p); t1 the odd items.
       const __m512i lo = _mm512_setr_epi64(0, 1, 8, 9, 4, 5, 12, 13);
       const __m512i hi = _mm512_setr_epi64(2, 3, 10, 11, 6, 7, 14, 15);
-      const __m512d u0 = _mm512_permutex2var_pd(t0, lo, t2), u1 = _mm512_permutex2var_pd(t1, lo, t3);
-      const __m512d u2 = _mm512_permutex2var_pd(t0, hi, t2), u3 = _mm512_permutex2var_pd(t1, hi, t3);
-      _mm512_storeu_pd(rec, _mm512_shuffle_f64x2(u0, u1, 0x44));
-      _mm512_storeu_pd(rec + 8, _mm512_shuffle_f64x2(u2, u3, 0x44));
-      _mm512_storeu_pd(rec + 16, _mm512_shuffle_f64x2(u0, u1, 0xEE));
-      _mm512_storeu_pd(rec + 24, _mm512_shuffle_f64x2(u2, u3, 0xEE));
+      q[0] = _mm512_permutex2var_pd(t0, lo, t2);
+      q[1] = _mm512_permutex2var_pd(t1, lo, t3);
+      q[2] = _mm512_permutex2var_pd(t0, hi, t2);
+      q[3] = _mm512_permutex2var_pd(t1, hi, t3);
+    };
+    __m512d u[4];  // values 0..3
+    quarters(v, u);
+    if constexpr (Width == 4) {  // the low halves of u[0] and u[1] are items 0 and 1: one line
+      _mm512_storeu_pd(rec, _mm512_shuffle_f64x2(u[0], u[1], 0x44));
+      _mm512_storeu_pd(rec + 8, _mm512_shuffle_f64x2(u[2], u[3], 0x44));
+      _mm512_storeu_pd(rec + 16, _mm512_shuffle_f64x2(u[0], u[1], 0xEE));
+      _mm512_storeu_pd(rec + 24, _mm512_shuffle_f64x2(u[2], u[3], 0xEE));
     } else {
-      // Rows of items -> pairs of two-element runs -> half records -> records.
-      const __m512d t0 = _mm512_unpacklo_pd(v[0], v[1]), t1 = _mm512_unpackhi_pd(v[0], v[1]);
-      const __m512d t2 = _mm512_unpacklo_pd(v[2], v[3]), t3 = _mm512_unpackhi_pd(v[2], v[3]);
-      const __m512d t4 = _mm512_unpacklo_pd(v[4], v[5]), t5 = _mm512_unpackhi_pd(v[4], v[5]);
-      const __m512d t6 = _mm512_unpacklo_pd(v[6], v[7]), t7 = _mm512_unpackhi_pd(v[6], v[7]);
-      // t0 = v0_0 v1_0 v0_2 v1_2 v0_4 v1_4 v0_6 v1_6 (vj_p: value j of item p); t1 the odd items.
-      const __m512i lo = _mm512_setr_epi64(0, 1, 8, 9, 4, 5, 12, 13);
-      const __m512i hi = _mm512_setr_epi64(2, 3, 10, 11, 6, 7, 14, 15);
-      // u0 = values 0..3 of items 0 and 4, u1 of items 1 and 5, u2 of 2 and 6, u3 of 3 and 7; w*
-      // the same for values 4..7.
-      const __m512d u[4] = {_mm512_permutex2var_pd(t0, lo, t2), _mm512_permutex2var_pd(t1, lo, t3),
-                            _mm512_permutex2var_pd(t0, hi, t2), _mm512_permutex2var_pd(t1, hi, t3)};
-      const __m512d w[4] = {_mm512_permutex2var_pd(t4, lo, t6), _mm512_permutex2var_pd(t5, lo, t7),
-                            _mm512_permutex2var_pd(t4, hi, t6), _mm512_permutex2var_pd(t5, hi, t7)};
+      __m512d w[4];  // values 4..7
+      quarters(v + 4, w);
       for (int p = 0; p < 4; ++p) {
         if constexpr (Stream && Width == 8) {  // whole 64-byte lines, 64-byte aligned
           _mm512_stream_pd(rec + Width * p, _mm512_shuffle_f64x2(u[p], w[p], 0x44));
@@ -168,10 +163,8 @@ struct SimdLanes {
         }
       }
       if constexpr (Width == 12) {  // values 8..11: quarter lines
-        const __m512d s0 = _mm512_unpacklo_pd(v[8], v[9]), s1 = _mm512_unpackhi_pd(v[8], v[9]);
-        const __m512d s2 = _mm512_unpacklo_pd(v[10], v[11]), s3 = _mm512_unpackhi_pd(v[10], v[11]);
-        const __m512d x[4] = {_mm512_permutex2var_pd(s0, lo, s2), _mm512_permutex2var_pd(s1, lo, s3),
-                              _mm512_permutex2var_pd(s0, hi, s2), _mm512_permutex2var_pd(s1, hi, s3)};
+        __m512d x[4];
+        quarters(v + 8, x);
         for (int p = 0; p < 4; ++p) {
           _mm256_store_pd(rec + Width * p + 8, _mm512_castpd512_pd256(x[p]));
           _mm256_store_pd(rec + Width * (p + 4) + 8, _mm512_extractf64x4_pd(x[p], 1));
