@@ -7,7 +7,7 @@
 --   build/asperity run scripts/calibrate_rev.lua                               # out/calibration/
 --   build/asperity run scripts/calibrate_rev.lua seeds=1,2,3,4 bond_shear_ratio=0.3 rotation_lock_bonds=3
 --
--- The other micro-parameters (bond_shear_ratio, bond_radius_factor, rotation_lock_bonds,
+-- The other micro-parameters (bond_shear_ratio, bond_normal_stiffness, bond_radius_factor, rotation_lock_bonds,
 -- bond_gap, genesis_stress, porosity) are passed to rev.lua; materials.lua's are the defaults.
 -- Each packing is made once (rev.lua's cache). The REV tensile strength is proportional to st
 -- while no bond breaks before the test (E_REV and the bond stresses the genesis leaves do not
@@ -28,6 +28,7 @@ local P = params_lib.parse{
   {"compression", true, doc = "also test the calibrated st in compression"},
   {"isotropy", true, doc = "also E and nu along x and y"},
   {"bond_shear_ratio", mat.rev.bond_shear_ratio, min = 0, doc = "passed to rev.lua"},
+  {"bond_normal_stiffness", mat.rev.bond_normal_stiffness, above = 0, doc = "passed to rev.lua"},
   {"bond_radius_factor", mat.rev.bond_radius_factor, above = 0, max = 1, doc = "passed to rev.lua"},
   {"rotation_lock_bonds", mat.rev.rotation_lock_bonds, type = "integer", min = 1, doc = "passed to rev.lua"},
   {"rotation_lock_beams", mat.rev.rotation_lock_beams, doc = "passed to rev.lua"},
@@ -65,7 +66,8 @@ local rev_script = asperity.scripts_dir .. "/rev.lua"
 
 local function rev(st, tests, seed, name)
   params = {tensile_strength = st, tests = tests, seed = seed, cache = cache,
-            bond_shear_ratio = P.bond_shear_ratio, bond_radius_factor = P.bond_radius_factor,
+            bond_shear_ratio = P.bond_shear_ratio, bond_normal_stiffness = P.bond_normal_stiffness,
+            bond_radius_factor = P.bond_radius_factor,
             rotation_lock_bonds = P.rotation_lock_bonds, rotation_lock_beams = P.rotation_lock_beams, bond_gap = P.bond_gap,
             contact_strength = P.contact_strength, contact_shear_strength = P.contact_shear_strength,
             contact_bond_friction = P.contact_bond_friction,
@@ -163,8 +165,17 @@ end
 local record = {seeds = seeds}
 for _, key in ipairs{"young_modulus_pa", "poisson_ratio", "tensile_strength_mpa", "compressive_strength_mpa",
                      "strength_ratio"} do
-  record[key] = {mean = result[key].mean, sd = result[key].sd}
+  if result[key] then record[key] = {mean = result[key].mean, sd = result[key].sd} end  -- none without compression
 end
-print(("put into scripts/lib/materials.lua M.rev: young_modulus = %.5g, bond_tensile_strength = %.5g,\n  calibration = %s")
-      :format(result.young_modulus_pa.mean, result.bond_tensile_strength_pa, require("genesis").serialise(record)))
+-- The bond micro-parameters given here that differ from materials.lua's go there too.
+local changed = {}
+for _, key in ipairs{"bond_shear_ratio", "bond_normal_stiffness", "bond_radius_factor", "rotation_lock_bonds",
+                     "rotation_lock_beams", "contact_strength", "contact_shear_strength", "contact_bond_friction"} do
+  if P[key] ~= mat.rev[key] then
+    changed[#changed + 1] = ("%s = %s,"):format(key, type(P[key]) == "string" and ("%q"):format(P[key]) or tostring(P[key]))
+  end
+end
+print(("put into scripts/lib/materials.lua M.rev: young_modulus = %.5g, bond_tensile_strength = %.5g,%s\n  calibration = %s")
+      :format(result.young_modulus_pa.mean, result.bond_tensile_strength_pa,
+              #changed > 0 and (" " .. table.concat(changed, " ")) or "", require("genesis").serialise(record)))
 return result

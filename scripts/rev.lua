@@ -10,8 +10,8 @@
 --    without friction by radius expansion in frictionless walls; the isotropic stress
 --    `genesis_stress` installed by one radius factor; particles with fewer than 3 contacts taken
 --    out; friction restored. The packing is cached (cache=) for calibrations.
--- 2. Two copies of the packing get bonds (every contact; beam_kn = kn, beam_ks = bond_shear_ratio
---    kn, Rb = bond_radius_factor min(Ra, Rb); contacts keep their forces, beams start at zero,
+-- 2. Two copies of the packing get bonds (every contact; beam_kn = bond_normal_stiffness kn,
+--    beam_ks = bond_shear_ratio beam_kn, Rb = bond_radius_factor min(Ra, Rb); contacts keep their forces, beams start at zero,
 --    model.md 5): unbreakable (the elastic model: E, nu, G) and breakable with the elliptic
 --    criterion of strength st (`tensile_strength`; strengths). Walls removed, cycled to
 --    equilibrium. The bond stresses left are reported (histogram, CSV) with the strength each bond
@@ -69,6 +69,8 @@ local P = params_lib.parse{
   {"tensile_strength", rev.bond_tensile_strength, unit = "Pa", above = 0,
    doc = "bond strength st of the elliptic criterion (model units; the calibrated one by default)"},
   {"bond_shear_ratio", rev.bond_shear_ratio, min = 0, doc = "kbs / kbn of the parallel bonds"},
+  {"bond_normal_stiffness", rev.bond_normal_stiffness, above = 0,
+   doc = "kbn A / kn: the parallel bond's normal stiffness against the contact springs' (model.md 5: 1)"},
   {"bond_radius_factor", rev.bond_radius_factor, above = 0, max = 1, doc = "lambda: Rb = lambda min(Ra, Rb) [3-26]"},
   {"contact_strength", rev.contact_strength, type = "string",
    doc = "the contact bonds break at c st A: c > 0, \"inf\" (never) or \"beam\" (with the parallel bond) (model.md 5)"},
@@ -218,7 +220,8 @@ local function bonded(material, csv, axis)
              bond_stress = b.bond_stress}
 end
 
-local bond_material = {beam_kn = P.kn, beam_ks = P.kn * P.bond_shear_ratio, radius_factor = P.bond_radius_factor,
+local beam_kn = P.bond_normal_stiffness * P.kn
+local bond_material = {beam_kn = beam_kn, beam_ks = beam_kn * P.bond_shear_ratio, radius_factor = P.bond_radius_factor,
                        contact_strength = (mat.contact_strength(P.contact_strength)),
                        contact_shear_strength = (mat.contact_shear_strength(P.contact_shear_strength)),
                        contact_bond_friction = P.contact_bond_friction}

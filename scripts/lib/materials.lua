@@ -59,6 +59,7 @@ M.rev = {
   young_modulus = 112.11,         -- Pa, E_REV (model units), mean over the packings
   bond_tensile_strength = 0.028229, -- Pa, st of the elliptic criterion
   bond_shear_ratio = 0.3,         -- kbs / kbn of the parallel bonds
+  bond_normal_stiffness = 1,      -- kbn A / kn: the beam against the contact springs (model.md 5)
   bond_radius_factor = 1,         -- lambda [3-26]
   -- A bonded particle does not rotate (1: the thesis's rule); with k > 1 a damaged one only while
   -- it still holds k (model.md 2; neighbor/topology.cpp).
@@ -105,10 +106,12 @@ function M.contact_shear_strength(text)
                                        "or a number > 0 (cs of cs st A)")
 end
 
--- Bond material for world:install_bonds: beams as stiff in tension as the contact springs
--- (kbn A = kn), kbs = bond_shear_ratio kbn, lambda, the calibrated strength; `over` replaces fields.
+-- Bond material for world:install_bonds: kbn A = bond_normal_stiffness kn (1: the beam as stiff
+-- as the contact springs), kbs = bond_shear_ratio kbn, lambda, the calibrated strength; `over`
+-- replaces fields.
 function M.bond(over)
-  local b = {beam_kn = M.contact.kn, beam_ks = M.contact.kn * M.rev.bond_shear_ratio,
+  local kbn = M.rev.bond_normal_stiffness * M.contact.kn
+  local b = {beam_kn = kbn, beam_ks = kbn * M.rev.bond_shear_ratio,
              radius_factor = M.rev.bond_radius_factor,
              tensile_strength = M.rev.bond_tensile_strength,
              contact_strength = (M.contact_strength(M.rev.contact_strength)),

@@ -7,7 +7,7 @@
 local out = assert(params.out, "give out=DIRECTORY")
 local mat = require("materials")
 local cal = mat.rev.calibration
-params = {tests = "elastic,compression,tension", out = out, seed = cal.seeds[1]}
+params = {tests = "elastic,compression,tension", out = out, seed = cal.seeds[1], cache = out .. "/cache"}
 local s = dofile(asperity.scripts_dir .. "/rev.lua")
 local function within(value, stat, what)
   assert(math.abs(value - stat.mean) <= 3 * stat.sd,
@@ -44,6 +44,20 @@ for _, f in ipairs{"elastic_compression.h5", "fracture_tension.h5"} do
          f .. ": the parameters as attributes")
   assert(attr("parameter_lock_rotation") == "true", f .. ": a boolean parameter as text")
 end
+-- The beam's normal stiffness against the contact springs (bond_normal_stiffness, kbn A / kn) on
+-- the same packing: at 2 every bonded pair's springs grow by 1.5 (normal: (1 + 2) / (1 + 1)) to
+-- 1.75 (shear: (0.1 + 2 r) / (0.1 + r) kn with r = kbs / kbn = 0.3), unbonded contacts by 1. The
+-- network's stiffness is homogeneous of degree one and monotone in each spring, so E grows, by at
+-- most 1.75 (quasi-static elastic tests, rotations locked: no moments).
+assert(mat.rev.bond_normal_stiffness == 1 and mat.rev.bond_shear_ratio == 0.3, "the bounds below assume kbn A = kn, r = 0.3")
+params = {tests = "elastic", out = out .. "/stiffer_beams", seed = cal.seeds[1], cache = out .. "/cache",
+          bond_normal_stiffness = 2}
+local stiff = dofile(asperity.scripts_dir .. "/rev.lua")
+local ratio = stiff.young_modulus_pa / s.young_modulus_pa
+assert(ratio > 1 and ratio <= 1.75, ("E with kbn A = 2 kn / with kn: %.4f, outside (1, 1.75]"):format(ratio))
+assert(asperity.h5_attribute(out .. "/stiffer_beams/elastic_compression.h5", "/", "parameter_bond_normal_stiffness") == 2,
+       "bond_normal_stiffness recorded with the run's parameters")
+print(("kbn A = 2 kn: E_REV x %.4f, nu %.3f"):format(ratio, stiff.poisson_ratio))
 print(("E_REV %.4g Pa, nu %.3f, tensile %.3f MPa, compressive %.2f MPa, sc/st %.2f; worst bond %.3f st")
       :format(s.young_modulus_pa, s.poisson_ratio, s.tensile_strength_mpa, s.compressive_strength_mpa,
               s.strength_ratio, s.bond_stress_max_over_st))

@@ -57,6 +57,7 @@ local function cache_file(P, s)
     P.surface_file ~= "" and P.surface_file:gsub("[^%w]", "_") or P.surface, mat.genesis.grow_floaters and "v12" or "v8", s.n, s.h, P.thickness,
     P.porosity, P.seed, P.gap, P.pack_steps, P.genesis_stress, mat.genesis.floater_contacts,
     mat.rev.rotation_lock_bonds, mat.rev.bond_shear_ratio, mat.rev.bond_radius_factor, P.bond_gap)
+    .. (mat.rev.bond_normal_stiffness ~= 1 and ("_kb%.4g"):format(mat.rev.bond_normal_stiffness) or "")
     .. (P.wall_friction ~= 0 and ("_f%.3g"):format(P.wall_friction) or "")
     .. (P.genesis_shrink_gain ~= 1 and ("_sg%.3g"):format(P.genesis_shrink_gain) or "")
     .. (P.genesis_mass_floor ~= 0 and ("_mf%.3g"):format(P.genesis_mass_floor) or "")
