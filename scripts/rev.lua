@@ -11,11 +11,12 @@
 --    `genesis_stress` installed by one radius factor; particles with fewer than 3 contacts taken
 --    out; friction restored. The packing is cached (cache=) for calibrations.
 -- 2. Two copies of the packing get bonds (every contact; beam_kn = bond_normal_stiffness kn,
---    beam_ks = bond_shear_ratio beam_kn, Rb = bond_radius_factor min(Ra, Rb); contacts keep their forces, beams start at zero,
---    model.md 5): unbreakable (the elastic model: E, nu, G) and breakable with the elliptic
---    criterion of strength st (`tensile_strength`; strengths). Walls removed, cycled to
---    equilibrium. The bond stresses left are reported (histogram, CSV) with the strength each bond
---    needs to hold. Rotation is locked while a particle holds `rotation_lock_bonds` intact bonds.
+--    beam_ks = bond_shear_ratio beam_kn, Rb = bond_radius_factor min(Ra, Rb); contacts keep
+--    their forces, beams start at zero, model.md 5): unbreakable (the elastic model: E, nu, G)
+--    and breakable with the elliptic criterion of strength st (`tensile_strength`; strengths).
+--    Walls removed, cycled to equilibrium. The bond stresses left are reported (histogram, CSV)
+--    with the strength each bond needs to hold. Rotation is locked while a particle holds
+--    `rotation_lock_bonds` intact bonds.
 --    isotropy: the packing turned so that the z tests load it along x and along y.
 -- 3. Platens: particles within `platen` of the bottom / top face, rigid groups, rotation fixed;
 --    bottom fixed, top moved at `rate`. Stress = platen force / L^2 [3-43, 3-44]; strains from
