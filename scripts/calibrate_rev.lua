@@ -7,8 +7,9 @@
 --   build/asperity run scripts/calibrate_rev.lua                               # out/calibration/
 --   build/asperity run scripts/calibrate_rev.lua seeds=1,2,3,4 bond_shear_ratio=0.3 rotation_lock_bonds=3
 --
--- The other micro-parameters (bond_shear_ratio, bond_normal_stiffness, bond_radius_factor, rotation_lock_bonds,
--- bond_gap, genesis_stress, porosity) are passed to rev.lua; materials.lua's are the defaults.
+-- The other micro-parameters (bond_shear_ratio, bond_normal_stiffness, bond_radius_factor,
+-- rotation_lock_bonds, bond_gap, genesis_stress, porosity) are passed to rev.lua; materials.lua's
+-- are the defaults.
 -- Each packing is made once (rev.lua's cache). The REV tensile strength is proportional to st
 -- while no bond breaks before the test (E_REV and the bond stresses the genesis leaves do not
 -- depend on st), so the next trial is st * target / measured; it stops within `tolerance`.

@@ -46,7 +46,7 @@ for _, f in ipairs{"elastic_compression.h5", "fracture_tension.h5"} do
 end
 -- The beam's normal stiffness against the contact springs (bond_normal_stiffness, kbn A / kn) on
 -- the same packing: at 2 every bonded pair's springs grow by 1.5 (normal: (1 + 2) / (1 + 1)) to
--- 1.75 (shear: (0.1 + 2 r) / (0.1 + r) kn with r = kbs / kbn = 0.3), unbonded contacts by 1. The
+-- 1.75 (shear: (0.1 + 2 r) / (0.1 + r), ks = 0.1 kn, r = kbs / kbn = 0.3), unbonded contacts by 1. The
 -- network's stiffness is homogeneous of degree one and monotone in each spring, so E grows, by at
 -- most 1.75 (quasi-static elastic tests, rotations locked: no moments).
 assert(mat.rev.bond_normal_stiffness == 1 and mat.rev.bond_shear_ratio == 0.3, "the bounds below assume kbn A = kn, r = 0.3")
