@@ -221,8 +221,8 @@ local function bonded(material, csv, axis)
              bond_stress = b.bond_stress}
 end
 
-local beam_kn = P.bond_normal_stiffness * P.kn
-local bond_material = {beam_kn = beam_kn, beam_ks = beam_kn * P.bond_shear_ratio, radius_factor = P.bond_radius_factor,
+local beam_kn, beam_ks = mat.beam_stiffness(P.kn, P.bond_normal_stiffness, P.bond_shear_ratio)
+local bond_material = {beam_kn = beam_kn, beam_ks = beam_ks, radius_factor = P.bond_radius_factor,
                        contact_strength = (mat.contact_strength(P.contact_strength)),
                        contact_shear_strength = (mat.contact_shear_strength(P.contact_shear_strength)),
                        contact_bond_friction = P.contact_bond_friction}

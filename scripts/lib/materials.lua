@@ -106,12 +106,18 @@ function M.contact_shear_strength(text)
                                        "or a number > 0 (cs of cs st A)")
 end
 
--- Bond material for world:install_bonds: kbn A = bond_normal_stiffness kn (1: the beam as stiff
--- as the contact springs), kbs = bond_shear_ratio kbn, lambda, the calibrated strength; `over`
--- replaces fields.
+-- The beam's stiffnesses (beam_kn = kbn A, beam_ks = kbs A) from the contact's kn: kbn A =
+-- normal kn (1: the beam as stiff as the contact springs), kbs = shear_ratio kbn.
+function M.beam_stiffness(kn, normal, shear_ratio)
+  local kbn = normal * kn
+  return kbn, kbn * shear_ratio
+end
+
+-- Bond material for world:install_bonds: the calibrated beam stiffnesses (M.beam_stiffness),
+-- lambda, the calibrated strength; `over` replaces fields.
 function M.bond(over)
-  local kbn = M.rev.bond_normal_stiffness * M.contact.kn
-  local b = {beam_kn = kbn, beam_ks = kbn * M.rev.bond_shear_ratio,
+  local kbn, kbs = M.beam_stiffness(M.contact.kn, M.rev.bond_normal_stiffness, M.rev.bond_shear_ratio)
+  local b = {beam_kn = kbn, beam_ks = kbs,
              radius_factor = M.rev.bond_radius_factor,
              tensile_strength = M.rev.bond_tensile_strength,
              contact_strength = (M.contact_strength(M.rev.contact_strength)),
