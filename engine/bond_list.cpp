@@ -55,8 +55,10 @@ bool settle_frozen_bonds(State& s) {
     const std::int32_t g = p.group[std::size_t(a)];
     return g >= 0 && g == p.group[std::size_t(b)] && s.groups[std::size_t(g)].lazy;
   };
+  // A dead bond (BondStore::dead) stays where it is until compact_bonds takes it out.
+  auto goes_frozen = [&](const BondStore& q, std::size_t k) { return !q.dead(k) && frozen_here(q.a[k], q.b[k]); };
   std::size_t to_freeze = 0, to_thaw = 0;
-  for (std::size_t k = 0; k < s.bonds.n; ++k) to_freeze += frozen_here(s.bonds.a[k], s.bonds.b[k]);
+  for (std::size_t k = 0; k < s.bonds.n; ++k) to_freeze += goes_frozen(s.bonds, k);
   for (std::size_t k = 0; k < s.frozen_bonds.n; ++k)
     to_thaw += !frozen_here(s.frozen_bonds.a[k], s.frozen_bonds.b[k]);
   if (to_freeze == 0 && to_thaw == 0) return false;
@@ -67,11 +69,11 @@ bool settle_frozen_bonds(State& s) {
   for (int f = 0; f < 2; ++f) {
     const BondStore& q = *from[f];
     std::size_t count[2] = {0, 0};
-    for (std::size_t k = 0; k < q.n; ++k) ++count[frozen_here(q.a[k], q.b[k])];
+    for (std::size_t k = 0; k < q.n; ++k) ++count[goes_frozen(q, k)];
     for (int t = 0; t < 2; ++t) stores[f][t].resize(count[t]);
     std::size_t at[2] = {0, 0};
     for (std::size_t k = 0; k < q.n; ++k) {
-      const int t = frozen_here(q.a[k], q.b[k]);
+      const int t = goes_frozen(q, k);
       stores[f][t].copy_from(q, k, at[t]++);
     }
   }
@@ -91,12 +93,18 @@ void process_breaks(State& s) {
   BondStore& q = s.bonds;
   double any = 0;
   for (double b : s.ctx.bond_block_breaks) any += b;
-  s.ctx.bond_block_breaks.clear();
-  if (any == 0) return;
+  if (any == 0) {
+    s.ctx.bond_block_breaks.clear();
+    return;
+  }
+  // Only the bond stage's blocks that flagged a break are looked at (bond_stage's blocks).
+  std::vector<double> block_breaks;
+  block_breaks.swap(s.ctx.bond_block_breaks);
+  const std::size_t block = pair_block_size(q.padded);
   const ParticleStore& p = s.p;
-  // The broken bonds are handled in place; those of which nothing holds any more leave the list
-  // at the end, column by column (a break step allocates no store: at thesis scale the bond list
-  // is tens of MB, and fresh pages for it on every break step cost as much as the bond stage).
+  // The broken bonds are handled in place; those of which nothing holds any more stay in their
+  // slots, dead, until the next neighbour build (compact_bonds): a break step does no pass over
+  // the whole bond list.
   BondLosses losses;
   // The freed pairs (bonds of which nothing holds any more), in bond order (sorted by (a, b) like
   // the bond list they come from), made while the bond's slot is still intact. A touching one
@@ -108,9 +116,14 @@ void process_breaks(State& s) {
   const BondMaterial& bm = q.material;
   const bool with_beam = bm.contact_strength == 0;
   for (std::size_t k = 0; k < q.n; ++k) {
+    if (block_breaks[k / block] == 0) {  // none in this block: on to the next
+      k = (k / block + 1) * block - 1;
+      continue;
+    }
     if (q.broken[k] == 0) continue;
     const auto parts = static_cast<int>(q.broken[k]);
-    const int holds = static_cast<int>(q.holds[k]) & ~parts;
+    const int held = static_cast<int>(q.holds[k]);
+    const int holds = held & ~parts;
     const auto a = q.a[k], b = q.b[k];
     const Vec3 n{q.nx[k], q.ny[k], q.nz[k]};
     BreakEvent ev;
@@ -163,8 +176,13 @@ void process_breaks(State& s) {
     if (holds != 0) {  // the other part holds: the bond stays, with what is left of it
       q.holds[k] = holds;
       losses.partial_left = true;
+      if (held == int(kBothHold)) ++s.cache.partial_bonds;
       continue;
     }
+    if (held != int(kBothHold)) --s.cache.partial_bonds;
+    // Dead (BondStore::dead): the kernel neither acts nor breaks on a bond of zero radius.
+    q.holds[k] = 0;
+    q.beam_radius[k] = 0;
     losses.gone.push_back(k);
     losses.gone_ends.push_back(a);
     losses.gone_ends.push_back(b);
@@ -192,7 +210,8 @@ void process_breaks(State& s) {
     }
   }
   freed.resize(nfreed);
-  q.remove(losses.gone);
+  block_breaks.clear();
+  block_breaks.swap(s.ctx.bond_block_breaks);  // its storage back for the next step
   refresh_bond_topology_after_breaks(s, losses);
   // Into the pair list without a rebuild: a fracture run breaks bonds on most of its steps, and a
   // rebuild for each would rebuild the list (and reorder the particles) nearly every step.

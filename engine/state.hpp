@@ -33,7 +33,12 @@ struct Caches {
   // refresh_bond_topology whenever the bond list changes.
   // A break takes a partner out of its particle's run, which stays sorted and ends in
   // kNoPartner slots (refresh_bond_topology_after_breaks) until the next full refresh.
+  // The entries of dead bonds (BondStore::dead) point to the zero record instead, in their place,
+  // until compact_bonds takes the bonds out and rebuilds the incidence (the next neighbour build).
   Incidence bond_incidence;
+  std::vector<std::size_t> dead_bonds;  // their indices in s.bonds, in no order
+  // Per particle, 1 where it holds a bond the step computes (a live entry of bond_incidence).
+  std::vector<std::uint8_t> bond_held;
   std::vector<std::int32_t> partner_start, partners;
   // Per particle, its bonds whose parallel bond holds (frozen ones too): kept only while the
   // rotation lock counts beams alone (WorldSettings::rotation_lock_beams).
@@ -55,8 +60,10 @@ struct Caches {
   // that neither carries nor stores them (stages/bonds.cpp).
   bool bond_moments_zero = false;
   // Some bond lost its beam or its contact bond (BondStore::holds): the bond kernel reads what
-  // holds; else every bond holds both and the column is not read. Set by refresh_bond_topology.
+  // holds; else every bond holds both and the column is not read. Set by refresh_bond_topology,
+  // with the count of such bonds, which breaks keep up to date.
   bool bonds_partial = false;
+  std::size_t partial_bonds = 0;
   // Some particle holding a bond the step computes turns (particle_turns): the bond records must
   // carry the torque of the bonds' shear forces. Valid while bond_ends_turn_known: cleared by a
   // new bond topology and by the API (membership, group motions); a break can only free the
@@ -197,10 +204,12 @@ inline void changed(State& s, Change c) {
 }
 
 // f(store, k) for every bond: the ones the step computes (s.bonds), then the frozen ones.
+// Dead records (BondStore::dead) are no bonds and are left out.
 template <class F>
 void for_each_bond(const State& s, F&& f) {
   for (const BondStore* q : {&s.bonds, &s.frozen_bonds})
-    for (std::size_t k = 0; k < q->n; ++k) f(*q, k);
+    for (std::size_t k = 0; k < q->n; ++k)
+      if (!q->dead(k)) f(*q, k);
 }
 
 // Threads for a parallel stage. Automatic (settings.threads == 0): one per 10 000 units of

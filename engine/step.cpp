@@ -225,6 +225,7 @@ Vec3 bond_torque_left_out(const State& s, std::size_t i) {
   // the bond kernel stored them.
   for (std::int32_t e = inc.start[i]; e < inc.start[i + 1]; ++e) {
     const auto k = std::size_t(inc.entry[std::size_t(e)] >> 1);
+    if (k >= q.n) continue;  // a dead bond's (BondStore::zero_record)
     const Vec3 n{q.nx[k], q.ny[k], q.nz[k]};
     const Vec3 shear{q.fsx[k] + q.fbsx[k], q.fsy[k] + q.fbsy[k], q.fsz[k] + q.fbsz[k]};
     t -= cross(n, shear) * (s.p.radius[i] - 0.5 * q.overlap[k]);
@@ -248,7 +249,7 @@ OverlapRatio deepest_overlap(const State& s, bool turning_only) {
   const WallContacts& wc = s.walls.contacts;
   for (std::size_t k = 0; k < wc.n; ++k) consider(wc.overlap[k], wc.particle[k], -1);
   // A bond's contact spring is a contact too: a bonded pair pressed a radius deep is as
-  // meaningless (broken bonds leave the store in process_breaks).
+  // meaningless (broken bonds leave the bonds in process_breaks: BondStore::dead).
   for_each_bond(s, [&](const BondStore& q, std::size_t k) { consider(q.overlap[k], q.a[k], q.b[k]); });
   return worst;
 }
@@ -476,7 +477,7 @@ GroupStageView group_view(State& s) {
 
 IntegrateStageView integrate_view(State& s) {
   return {s.p, s.pairs, s.incidence, s.walls.contacts, s.bonds, s.cache.bond_incidence,
-          s.cache.bond_records, s.cache.idle, s.cache.block_free,
+          s.cache.bond_held, s.cache.bond_records, s.cache.idle, s.cache.block_free,
           s.cache.block_busy, s.cache.spin_known, s.cache.spin_reachable, s.cache.spin_bonded,
           s.settings.gravity, s.settings.local_damping, s.dt, s.any_rotating, s.ctx};
 }

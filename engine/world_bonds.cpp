@@ -6,6 +6,7 @@
 
 #include "kernels/bond_law.hpp"
 #include "bond_list.hpp"
+#include "neighbor/topology.hpp"
 #include "state.hpp"
 #include "step.hpp"
 
@@ -30,6 +31,7 @@ std::size_t World::install_bonds(const BondMaterial& given, double tolerance,
   if (material.beam_ks == 0) material.beam_ks = material.beam_kn / 10;
   const std::string problem = detail::bond_material_problem(material);
   require(problem.empty(), "install_bonds: " + problem);
+  detail::compact_bonds(s);  // dead bonds are none, and a dead bond's pair may be bonded again
   if (s.bonds.n + s.frozen_bonds.n > 0)
     require(s.bonds.material == material,
             "install_bonds: the world already holds bonds of another material (one bond material "

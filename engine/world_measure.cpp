@@ -48,6 +48,7 @@ double World::unbalanced_force_ratio() const {
     if (s.walls.contacts.overlap[k] > 0) { contact += s.walls.contacts.fn[k]; ++contacts; }
   // Intact bonds carry contact force too, in tension as well: |contact bond + parallel bond|.
   for (std::size_t k = 0; k < s.bonds.n; ++k) {
+    if (s.bonds.dead(k)) continue;
     contact += std::abs(s.bonds.fn[k] + s.bonds.fbn[k]);
     ++contacts;
   }

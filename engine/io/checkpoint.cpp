@@ -493,8 +493,10 @@ void validate(const State& s, const std::string& path) {
   const auto& b = s.bonds;
   pair_like(b, "bonds", bond_columns);
   for (std::size_t k = 0; k < b.n; ++k) need(b.beam_radius[k] >= 0, "bonds/beam_radius");
+  // 0: a dead bond (BondStore::dead), kept until the saved run's next neighbour build, with no radius.
   for (std::size_t k = 0; k < b.n; ++k)
-    need(b.holds[k] == detail::kBeamHolds || b.holds[k] == detail::kContactBondHolds || b.holds[k] == detail::kBothHold,
+    need(b.holds[k] == detail::kBeamHolds || b.holds[k] == detail::kContactBondHolds || b.holds[k] == detail::kBothHold ||
+             (b.holds[k] == 0 && b.beam_radius[k] == 0),
          "bonds/holds");
   need(setting_valid(Field{"material"}, b.material), "bonds/material");
   for (const BreakEvent& e : s.break_events)

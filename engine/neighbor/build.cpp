@@ -506,6 +506,7 @@ void ensure_skin(State& s) {
 
 void build_neighbors(State& s) {
   ParticleStore& p = s.p;
+  compact_bonds(s);  // the bonds that broke since the last build leave the list (before a reorder)
   sync_lazy(s);  // idle group members are searched: bring them to where they are
   ensure_skin(s);
   CellGrid grid = make_grid(p, s.skin, s.step);

@@ -13,17 +13,21 @@ namespace asperity::detail {
 void refresh_bond_topology(State& s);
 
 // What a break step did to the bond list (process_breaks): the bonds of which nothing holds any
-// more, taken out (their indices before, ascending, and their ends a, b in pairs), and the ends
-// of the bonds whose parallel bond broke.
+// more, now dead (BondStore::dead: their indices, ascending, and their ends a, b in pairs), and
+// the ends of the bonds whose parallel bond broke.
 struct BondLosses {
   std::vector<std::size_t> gone;
   std::vector<std::int64_t> gone_ends, beam_ends;
   bool partial_left = false;  // some bond lost one part and keeps the other
 };
-// The topology brought up to date after such a step in what the step changed (the incidence
-// again when bonds left, the partners, locks and counts of their particles): the same as
-// refresh_bond_topology, without the passes over every particle and bond that a step with a
-// few breaks in a large specimen would otherwise pay.
+// The topology brought up to date after such a step in what the step changed (the dead bonds'
+// incidence entries, the partners, locks and counts of their particles): the same as
+// refresh_bond_topology, in work proportional to the breaks, not to the particles and bonds.
 void refresh_bond_topology_after_breaks(State& s, const BondLosses& losses);
+
+// The dead bonds taken out of the list and the incidence rebuilt without them (at a neighbour
+// build, before the particles may be reordered). The forces, their sums and every flag stay as
+// they were; only the bond indices move (bond_version).
+void compact_bonds(State& s);
 
 }  // namespace asperity::detail

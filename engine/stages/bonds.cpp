@@ -61,6 +61,10 @@ StageLoop bond_stage(const BondStageView& s) {
   s.records = kernel == ks.bond_forces      ? BondRecord::forces
               : kernel == ks.bond_no_moment ? BondRecord::levers
                                             : BondRecord::moments;
+  // The zero record in this layout, for the dead bonds' entries (BondStore::zero_record).
+  static constexpr double zero_record[kBondRecord] = {-0.0, -0.0, -0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -0.0, -0.0, -0.0, 0.0};
+  const std::size_t width = std::size_t(s.records);
+  std::copy_n(zero_record, width, s.bonds.out.data() + width * s.bonds.zero_record());
   const std::size_t total = s.bonds.padded;
   const std::size_t block = pair_block_size(total);
   st.blocks = (total + block - 1) / block;

@@ -216,7 +216,7 @@ void update_servo_stiffness(const GroupStageView& s) {
       if (p.group[s.pairs.a[k]] != p.group[s.pairs.b[k]]) s.servo.pairs.push_back(std::uint32_t(k));
     s.servo.bonds.clear();
     for (std::size_t k = 0; k < s.bonds.n; ++k)
-      if (p.group[s.bonds.a[k]] != p.group[s.bonds.b[k]]) s.servo.bonds.push_back(std::uint32_t(k));
+      if (!s.bonds.dead(k) && p.group[s.bonds.a[k]] != p.group[s.bonds.b[k]]) s.servo.bonds.push_back(std::uint32_t(k));
     s.servo.bond_ends.assign(s.groups.size(), 0);
     for (std::uint32_t k : s.servo.bonds)
       for (const std::int64_t i : {s.bonds.a[k], s.bonds.b[k]})

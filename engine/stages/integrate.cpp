@@ -115,7 +115,7 @@ StageLoop integrate_stage(const IntegrateStageView& s) {
   // stages give members their group's (bookkeep adds it). Once something spins the answer cannot
   // change until it is cleared, so nothing is read then (the lattice, where both say so).
   const ParticleStore* const ps = &p;
-  const std::int32_t* bond_start = binc.start.size() > n ? binc.start.data() : nullptr;
+  const std::uint8_t* bond_held = s.bond_held.size() >= n && bq.n > 0 ? s.bond_held.data() : nullptr;
   const bool full = !s.spin_known;  // bookkeep starts the answer afresh then
   const bool track =
       s.any_rotating && (full || s.spin_reachable == 0 || (bq.n > 0 && s.spin_bonded == 0));
@@ -124,11 +124,11 @@ StageLoop integrate_stage(const IntegrateStageView& s) {
     auto bits = [=](std::size_t i) { return ps->spin_bits(i); };
     auto is_inert = [=](std::size_t i) { return std::uint64_t(0) - std::uint64_t(inert[i] != 0); };
     std::uint64_t reachable = 0, bonded = 0;
-    if (bond_start) {
+    if (bond_held) {
       for (std::size_t i = first; i < end; ++i) {
         const std::uint64_t b = bits(i);
         reachable |= b & ~is_inert(i);
-        bonded |= b & (std::uint64_t(0) - std::uint64_t(bond_start[i + 1] > bond_start[i]));
+        bonded |= b & (std::uint64_t(0) - std::uint64_t(bond_held[i] != 0));
       }
     } else {
       for (std::size_t i = first; i < end; ++i) reachable |= bits(i) & ~is_inert(i);

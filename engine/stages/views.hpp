@@ -68,6 +68,7 @@ struct IntegrateStageView {
   const WallContacts& wall_contacts;
   const BondStore& bonds;
   const Incidence& bond_incidence;
+  const std::vector<std::uint8_t>& bond_held;  // Caches::bond_held: which particles hold a bond
   kernels::BondRecord bond_records;  // the layout the bond stage wrote
   // The idle split of rigid groups (Caches::idle, block_free, block_busy).
   const std::vector<std::uint8_t>& idle;

@@ -41,7 +41,8 @@ struct BondStore {
   AVec<double> holds;                     // kBeamHolds | kContactBondHolds (installed: both).
                                           // Without the beam its forces and moments are 0;
                                           // without the contact bond the contact springs follow
-                                          // the ordinary contact law (model.md 4)
+                                          // the ordinary contact law (model.md 4). 0: a dead
+                                          // record (dead(), below)
   AVec<double> broken;                    // what broke this step (kBeamHolds | kContactBondHolds
                                           // of the parts that broke); 0 between steps (the
                                           // kernel writes only where one breaks)
@@ -51,7 +52,8 @@ struct BondStore {
   // negated) and the beam moment on b mbn n + mbs (on a: its negative). While every moment is zero
   // the kernel without moments writes records of 8 (the first eight values, from out + 8 k: one
   // 64-byte line a bond instead of 1.5), and where besides no end of a bond turns, records of 4
-  // (from out + 4 k); Caches::bond_records says which (kernels::BondRecord).
+  // (from out + 4 k); Caches::bond_records says which (kernels::BondRecord). One more record
+  // after the padded ones, zero_record(), which the bond stage fills with zeros each step.
   AVec<double> out;
   BondMaterial material;
   bool any = false;                       // a material was set by a first installation
@@ -83,8 +85,17 @@ struct BondStore {
   }
   // The gather's columns are not saved: a store read from a checkpoint sizes them here.
   void size_outputs() {
-    out.resize(kBondRecord * padded);
+    out.resize(kBondRecord * (padded + 1));
   }
+  // A bond of which nothing holds any more, left in its slot until the next neighbour build
+  // (process_breaks, compact_bonds): zero beam radius, so the kernel neither acts nor breaks on
+  // it, and nothing holds, so every pass over the bonds leaves it out (for_each_bond). Leaving it
+  // there spares a break step the passes over the whole list that taking it out would cost.
+  bool dead(std::size_t k) const { return holds[k] == 0; }
+  // The record the incidence entries of dead bonds point to (Caches::bond_incidence): its force
+  // and moment -0 and its lever arm term +0, taken with the sign of b (+1), adds -0 to every sum
+  // of the gather, which leaves each sum's bits as they were without the term (x + -0 = x).
+  std::size_t zero_record() const { return padded; }
   void fill_padding(std::int64_t null_a, std::int64_t null_b) {
     pad_column(a, n, padded, double(null_a));
     pad_column(b, n, padded, double(null_b));

@@ -1082,7 +1082,9 @@ TEST(Bonds, BreakStepsLeaveTheTopologyAFullRefreshBuilds) {
   struct Topology {
     std::vector<std::int32_t> incidence_start, partners, bonded_particles, beam_count;
     std::vector<std::int64_t> incidence_entry;
-    std::vector<std::uint8_t> locked;
+    std::vector<std::uint8_t> locked, held;
+    std::vector<std::size_t> dead;
+    std::size_t partial_bonds;
     bool partial, moments_zero, any_rotating;
     bool operator==(const Topology&) const = default;
   };
@@ -1090,7 +1092,8 @@ TEST(Bonds, BreakStepsLeaveTheTopologyAFullRefreshBuilds) {
     const detail::Caches& c = s.cache;
     Topology t{c.bond_incidence.start, {}, c.bonded_particles, c.beam_count, c.bond_incidence.entry,
                std::vector<std::uint8_t>(s.p.rotation_locked.begin(), s.p.rotation_locked.begin() + std::ptrdiff_t(s.p.n)),
-               c.bonds_partial, c.bond_moments_zero, s.any_rotating};
+               c.bond_held, c.dead_bonds, c.partial_bonds, c.bonds_partial, c.bond_moments_zero, s.any_rotating};
+    std::sort(t.dead.begin(), t.dead.end());
     for (const std::int32_t o : c.partners)
       if (o != detail::kNoPartner) t.partners.push_back(o);
     return t;
@@ -1115,7 +1118,7 @@ TEST(Bonds, BreakStepsLeaveTheTopologyAFullRefreshBuilds) {
     for (std::size_t id = 0; id < w.particle_count(); ++id)
       w.set_velocity(std::int64_t(id), {2e-3 * u(rng), 2e-3 * u(rng), 2e-3 * u(rng)});
     detail::State& s = w.state();
-    bool some_partial = false, some_freed = false;
+    bool some_partial = false, some_freed = false, some_dead = false;
     // Compared after every fifth step that broke bonds (the breaks of the steps between pile up
     // in the runs of partners); only a step with breaks finds the kernel's flags again.
     for (int step = 0, breaking = 0; step < 400; ++step) {
@@ -1127,13 +1130,117 @@ TEST(Bonds, BreakStepsLeaveTheTopologyAFullRefreshBuilds) {
       ASSERT_EQ(after_breaks, topology(s)) << "after step " << w.step_count();
       some_partial = some_partial || s.cache.bonds_partial;
       some_freed = some_freed || s.any_rotating;
+      some_dead = some_dead || !s.cache.dead_bonds.empty();
     }
     const std::size_t breaks = w.break_events().size();
     EXPECT_GT(breaks, installed / 4) << "most steps break bonds";
     EXPECT_LT(w.bonds().size(), installed) << "bonds went whole";
     EXPECT_EQ(some_partial, rule.c != 0.0) << "contact bonds and beams break apart, unless together";
     EXPECT_TRUE(some_freed) << "damage frees particles";
+    EXPECT_TRUE(some_dead) << "bonds wait dead in the list for the next build";
   }
+}
+
+namespace {
+// The box of the test above, bonds installed (contact bonds breaking apart at 0.5 st A) and shaken
+// apart.
+World shaken_bonded_box() {
+  WorldSettings ws;
+  ws.dt = 5e-4;
+  World w = test::random_box(600, ws);
+  w.cycle(3000);
+  BondMaterial bm;
+  bm.tensile_strength = 0.05;
+  bm.contact_strength = 0.5;
+  w.install_bonds(bm, 2e-5);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (std::size_t id = 0; id < w.particle_count(); ++id)
+    w.set_velocity(std::int64_t(id), {2e-3 * u(rng), 2e-3 * u(rng), 2e-3 * u(rng)});
+  return w;
+}
+
+std::vector<double> motion_of(const World& w) {
+  std::vector<double> m = w.positions();
+  const std::vector<double> v = w.velocities();
+  m.insert(m.end(), v.begin(), v.end());
+  for (std::size_t id = 0; id < w.particle_count(); ++id) {
+    const Vec3 spin = w.angular_velocity(std::int64_t(id));
+    m.insert(m.end(), {spin.x, spin.y, spin.z});
+  }
+  return m;
+}
+
+bool same_bits(const std::vector<double>& x, const std::vector<double>& y) {
+  return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(double)) == 0;
+}
+
+bool same_events(const std::vector<BreakEvent>& x, const std::vector<BreakEvent>& y) {
+  if (x.size() != y.size()) return false;
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    const BreakEvent &a = x[k], &b = y[k];
+    const double ax[] = {a.time, a.position.x, a.position.y, a.position.z, a.sigma, a.tau, a.released_energy};
+    const double bx[] = {b.time, b.position.x, b.position.y, b.position.z, b.sigma, b.tau, b.released_energy};
+    if (a.step != b.step || a.id_a != b.id_a || a.id_b != b.id_b || a.kind != b.kind || a.mode != b.mode ||
+        std::memcmp(ax, bx, sizeof ax) != 0)
+      return false;
+  }
+  return true;
+}
+}  // namespace
+
+// A bond of which nothing holds stays in the list, dead, until the next neighbour build
+// (BondStore::dead); its incidence entries add -0 to the gather's sums, which leaves them as they
+// were. Against the same run with the dead bonds taken out after every step (the list a break
+// step used to leave): the motion of every particle, every break event and the stored and
+// released energies bit for bit. The friction booked by the bond kernel (contact springs whose
+// contact bond broke) is summed by blocks and SIMD lanes of the bond list, whose slots the dead
+// bonds shift: the same terms, grouped otherwise, so equal to rounding.
+TEST(Bonds, DeadBondsLeaveTheRunAsTakingThemOutAtOnce) {
+  World kept = shaken_bonded_box(), taken = shaken_bonded_box();
+  std::size_t most_dead = 0;
+  for (int step = 0; step < 400; ++step) {
+    kept.cycle(1);
+    taken.cycle(1);
+    most_dead = std::max(most_dead, kept.state().cache.dead_bonds.size());
+    detail::compact_bonds(taken.state());
+    ASSERT_TRUE(same_bits(motion_of(kept), motion_of(taken))) << "after step " << kept.step_count();
+  }
+  EXPECT_GT(most_dead, 20u) << "bonds died between builds";
+  EXPECT_GT(kept.state().rebuilds, 5u) << "and builds took them out";
+  EXPECT_GT(kept.break_events().size(), 500u);
+  EXPECT_TRUE(same_events(kept.break_events(), taken.break_events()));
+  EXPECT_EQ(kept.bond_count(), taken.bond_count());
+  const Energies a = kept.energies(), b = taken.energies();
+  EXPECT_EQ(a.kinetic, b.kinetic);
+  EXPECT_EQ(a.strain, b.strain);
+  EXPECT_EQ(a.released, b.released);
+  EXPECT_EQ(a.damping, b.damping);
+  EXPECT_GT(a.friction, 0.0);
+  EXPECT_NEAR(a.friction, b.friction, 1e-12 * a.friction);
+}
+
+// A checkpoint written while dead bonds wait for the next build keeps them where they were: the
+// loaded run goes on as the one that was not saved, bit for bit, its friction sums included.
+TEST(Bonds, ACheckpointKeepsTheDeadBondsInTheirSlots) {
+  World run = shaken_bonded_box(), saved = shaken_bonded_box();
+  for (int step = 0; step < 1000 && saved.state().cache.dead_bonds.empty(); ++step) {
+    saved.cycle(1);
+    run.cycle(1);
+  }
+  ASSERT_FALSE(saved.state().cache.dead_bonds.empty());
+  const std::string path = ::testing::TempDir() + "/dead_bonds.h5";
+  saved.save(path);
+  World loaded = World::load(path, 0, "auto");
+  EXPECT_EQ(loaded.state().cache.dead_bonds.size(), saved.state().cache.dead_bonds.size());
+  EXPECT_EQ(loaded.bond_count(), saved.bond_count());
+  EXPECT_EQ(loaded.bonds().size(), saved.bonds().size());
+  run.cycle(300);
+  loaded.cycle(300);
+  EXPECT_TRUE(same_bits(motion_of(run), motion_of(loaded)));
+  EXPECT_TRUE(same_events(run.break_events(), loaded.break_events()));
+  EXPECT_EQ(run.energies().friction, loaded.energies().friction);
+  EXPECT_EQ(run.energies().strain, loaded.energies().strain);
 }
 
 // Where no end of a bond turns the bond records hold the forces only (kernels::BondRecord::forces)
