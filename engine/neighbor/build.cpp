@@ -613,8 +613,24 @@ void insert_pairs(State& s, const PairStore& add) {
   merged.fill_padding(s.p.null_a(), s.p.null_b());
   std::swap(s.pairs, merged);
   build_incidence(s.p.n, s.pairs.a.data(), s.pairs.b.data(), s.pairs.n, s.incidence);
-  s.cache.servo.pairs_at = ~std::uint64_t(0);  // the servo's list holds pair indices
-  s.cache.idle_valid = false;                  // a member may have a pair now
+  // The servo's pairs joining two bodies (if current): their indices moved past the added pairs
+  // before them, and the added pairs joining two bodies join them, in the merged order.
+  ServoContacts& servo = s.cache.servo;
+  if (servo.pairs_at == s.rebuilds) {
+    const auto& group = s.p.group;
+    std::vector<std::uint32_t> listed;
+    listed.reserve(servo.pairs.size() + add.n);
+    std::size_t j = 0;
+    for (const std::uint32_t k : servo.pairs) {
+      for (; j < add.n && at[j] <= k; ++j)
+        if (group[add.a[j]] != group[add.b[j]]) listed.push_back(std::uint32_t(at[j] + j));
+      listed.push_back(std::uint32_t(k + j));
+    }
+    for (; j < add.n; ++j)
+      if (group[add.a[j]] != group[add.b[j]]) listed.push_back(std::uint32_t(at[j] + j));
+    servo.pairs.swap(listed);
+  }
+  s.cache.idle_valid = false;  // a member may have a pair now
 }
 
 }  // namespace asperity::detail

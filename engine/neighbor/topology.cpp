@@ -147,8 +147,20 @@ void refresh_bond_topology_after_breaks(State& s, const BondLosses& losses) {
   if (losses.gone.empty() && losses.beam_ends.empty() && !losses.partial_left) return;
   BondStore& q = s.bonds;
   Caches& c = s.cache;
+  // The servo's count of bond ends joining two bodies, if current, loses the dead bonds' ends.
+  const bool servo_current = c.servo.bonds_of == s.bond_version;
   ++s.bond_version;
   c.spin_known = false;
+  if (servo_current) {
+    const auto& group = s.p.group;
+    for (std::size_t e = 0; e < losses.gone_ends.size(); e += 2) {
+      const auto a = std::size_t(losses.gone_ends[e]), b = std::size_t(losses.gone_ends[e + 1]);
+      if (group[a] == group[b]) continue;
+      for (const std::size_t i : {a, b})
+        if (group[i] >= 0) --c.servo.bond_ends[std::size_t(group[i])];
+    }
+    c.servo.bonds_of = s.bond_version;
+  }
   if (!losses.gone.empty()) {
     // The bonds of which nothing holds stay in their slots, dead (BondStore::dead), until the next
     // neighbour build takes them out (compact_bonds): their entries point at the zero record.
@@ -199,7 +211,10 @@ void compact_bonds(State& s) {
   // The same incidence as the breaks' retired one without its retired entries: every other count
   // and flag of the bonds (bonded particles, partners, partial bonds, locks) is already current.
   build_incidence(s.p.n, q.a.data(), q.b.data(), q.n, c.bond_incidence);
-  ++s.bond_version;  // bond indices moved
+  // Bond indices moved (bond_version); the servo's count of bond ends does not change.
+  const bool servo_current = c.servo.bonds_of == s.bond_version;
+  ++s.bond_version;
+  if (servo_current) c.servo.bonds_of = s.bond_version;
 }
 
 }  // namespace asperity::detail

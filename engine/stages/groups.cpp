@@ -209,19 +209,21 @@ void update_servo_stiffness(const GroupStageView& s) {
     for (Dof d : g.motion.translation) servo = servo || d == Dof::servo;
   if (!servo) return;
   const ParticleStore& p = s.p;
-  if (s.servo.pairs_at != s.rebuilds || s.servo.bonds_of != s.bond_version ||
-      s.servo.bond_ends.size() != s.groups.size()) {
+  if (s.servo.pairs_at != s.rebuilds || s.servo.bond_ends.size() != s.groups.size()) {
     s.servo.pairs.clear();
     for (std::size_t k = 0; k < s.pairs.n; ++k)
       if (p.group[s.pairs.a[k]] != p.group[s.pairs.b[k]]) s.servo.pairs.push_back(std::uint32_t(k));
-    s.servo.bonds.clear();
-    for (std::size_t k = 0; k < s.bonds.n; ++k)
-      if (!s.bonds.dead(k) && p.group[s.bonds.a[k]] != p.group[s.bonds.b[k]]) s.servo.bonds.push_back(std::uint32_t(k));
-    s.servo.bond_ends.assign(s.groups.size(), 0);
-    for (std::uint32_t k : s.servo.bonds)
-      for (const std::int64_t i : {s.bonds.a[k], s.bonds.b[k]})
-        if (p.group[i] >= 0) ++s.servo.bond_ends[std::size_t(p.group[i])];
     s.servo.pairs_at = s.rebuilds;
+    s.servo.bonds_of = ~std::uint64_t(0);  // the groups may have changed with the build
+  }
+  if (s.servo.bonds_of != s.bond_version) {
+    s.servo.bond_ends.assign(s.groups.size(), 0);
+    for (std::size_t k = 0; k < s.bonds.n; ++k) {
+      const std::int64_t a = s.bonds.a[k], b = s.bonds.b[k];
+      if (s.bonds.dead(k) || p.group[a] == p.group[b]) continue;
+      for (const std::int64_t i : {a, b})
+        if (p.group[i] >= 0) ++s.servo.bond_ends[std::size_t(p.group[i])];
+    }
     s.servo.bonds_of = s.bond_version;
   }
   std::vector<double> K(s.groups.size(), 0.0);

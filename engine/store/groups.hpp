@@ -35,14 +35,16 @@ struct Group {
 };
 
 // Pairs joining two different bodies (group / group or group / free particle) of the current pair
-// list, for the servo's per-step stiffness; valid while State::rebuilds equals pairs_at. Likewise
-// the bonds joining two bodies (a joint's platens are tied by a few of its many bonds), valid while
-// the bond list is the one of version bonds_of.
+// list (ascending), for the servo's per-step stiffness; valid while State::rebuilds equals
+// pairs_at (a break step's freed pairs are merged into it: insert_pairs). Likewise, per group,
+// its ends of the bonds joining two bodies (a joint's platens are tied by a few of its many
+// bonds), valid while State::bond_version equals bonds_of (a break step counts its dead bonds
+// out: refresh_bond_topology_after_breaks).
 struct ServoContacts {
-  std::vector<std::uint32_t> pairs, bonds;
-  std::vector<std::uint32_t> bond_ends;  // per group: its ends of `bonds`
+  std::vector<std::uint32_t> pairs;
+  std::vector<std::uint32_t> bond_ends;
   std::uint64_t pairs_at = ~std::uint64_t(0);
-  std::uint64_t bonds_of = ~std::uint64_t(0);  // the State::bond_version they were taken from
+  std::uint64_t bonds_of = ~std::uint64_t(0);
 };
 
 }  // namespace asperity::detail

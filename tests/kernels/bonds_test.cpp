@@ -1376,3 +1376,68 @@ TEST(Bonds, ABadBondMaterialIsRefusedByNameAndNothingIsInstalled) {
   EXPECT_EQ(v.state().bonds.material.beam_kn, 3.0);
   EXPECT_EQ(v.state().bonds.material.beam_ks, 0.3);
 }
+
+// The servo's stiffness counts the pairs and bonds joining two bodies (stages/groups.cpp); a break
+// step keeps both counts current (the freed pairs merged into the list of pairs joining bodies,
+// the dead bonds' ends counted out) instead of taking them again from every pair and bond. A
+// bonded block sheared between two platens, its top one under the servo, against the same run
+// with the counts taken afresh at every step: the platens' stiffness and every particle's motion
+// bit for bit, with bonds joining the platens to the block broken on the way.
+TEST(Bonds, TheServoCountsAfterBreaksAreTheOnesTakenAfresh) {
+  constexpr int n = 10, layers = 6;
+  constexpr double d = 1e-3, a = 0.99 * d;
+  auto make = [&](int& top) {
+    WorldSettings ws;
+    ws.dt = 5e-4;
+    World w(ws);
+    std::vector<double> xyz;
+    for (int k = 0; k < layers; ++k)
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i)
+          for (double c : {(i + 0.5) * a, (j + 0.5) * a, (k + 0.5) * a}) xyz.push_back(c);
+    const std::int64_t first = w.add_particles(xyz, std::vector<double>(xyz.size() / 3, 0.5 * d));
+    std::vector<std::int64_t> bottom, upper;
+    for (std::int64_t k = 0; k < std::int64_t(xyz.size() / 3); ++k) {
+      const std::int64_t layer = k / (n * n);
+      if (layer == 0) bottom.push_back(first + k);
+      if (layer == layers - 1) upper.push_back(first + k);
+    }
+    BondMaterial bm;
+    bm.tensile_strength = 0.05;
+    bm.contact_strength = 0.5;
+    w.install_bonds(bm);
+    GroupMotion held;
+    held.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
+    w.add_group(bottom, held);
+    GroupMotion shear;
+    shear.translation = {Dof::velocity, Dof::fixed, Dof::servo};
+    shear.velocity = {2e-3, 0, 0};
+    shear.servo[2].target_force = 1e-6;
+    top = w.add_group(upper, shear);
+    return w;
+  };
+  int top = -1, top_afresh = -1;
+  World w = make(top), afresh = make(top_afresh);
+  std::size_t kept_steps = 0;
+  const std::uint32_t ends_before = [&] {
+    w.cycle(1);
+    afresh.cycle(1);
+    return w.state().cache.servo.bond_ends[std::size_t(top)];
+  }();
+  for (int step = 0; step < 600; ++step) {
+    const std::size_t breaks = w.break_events().size();
+    const std::uint64_t rebuilds = w.state().rebuilds;
+    w.cycle(1);
+    afresh.cycle(1);
+    // A break step that was no build kept the servo's pair list current.
+    kept_steps += w.break_events().size() > breaks && w.state().rebuilds == rebuilds &&
+                  w.state().cache.servo.pairs_at == w.state().rebuilds;
+    afresh.state().cache.servo.pairs_at = ~std::uint64_t(0);
+    afresh.state().cache.servo.bonds_of = ~std::uint64_t(0);
+    ASSERT_EQ(w.state().groups[std::size_t(top)].contact_stiffness,
+              afresh.state().groups[std::size_t(top_afresh)].contact_stiffness) << "step " << w.step_count();
+    ASSERT_TRUE(same_bits(motion_of(w), motion_of(afresh))) << "step " << w.step_count();
+  }
+  EXPECT_GT(kept_steps, 10u);
+  EXPECT_LT(w.state().cache.servo.bond_ends[std::size_t(top)], ends_before) << "bonds to the platen broke";
+}
