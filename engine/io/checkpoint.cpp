@@ -30,7 +30,7 @@ namespace asperity {
 namespace {
 
 using detail::State;
-constexpr int kCheckpointVersion = 13;  // 2: servo integral and integral time, group damping;
+constexpr int kCheckpointVersion = 14;  // 2: servo integral and integral time, group damping;
                                        // 3: rest overlaps (stress-free bonds);
                                        // 4: meshes' candidates within half the skin;
                                        // 5: a header with a checksum in the HDF5 user block;
@@ -44,7 +44,9 @@ constexpr int kCheckpointVersion = 13;  // 2: servo integral and integral time, 
                                        //     saving does not bring idle members up to date;
                                        // 12: rotation_lock_beams;
                                        // 13: the bond records' layout (4, 8 or 12 doubles), for
-                                       //     the torque's terms World::torque adds
+                                       //     the torque's terms World::torque adds;
+                                       // 14: dead bonds (nothing holds, zero radius), kept until
+                                       //     the next neighbour build (BondStore::dead)
 
 // The file's kind in the header of its HDF5 user block (io::h5::file_image), whose checksum is
 // verified before HDF5 parses the file: HDF5 does not survive every corruption of its metadata.
