@@ -31,8 +31,7 @@ std::size_t World::install_bonds(const BondMaterial& given, double tolerance,
   if (material.beam_ks == 0) material.beam_ks = material.beam_kn / 10;
   const std::string problem = detail::bond_material_problem(material);
   require(problem.empty(), "install_bonds: " + problem);
-  detail::compact_bonds(s);  // dead bonds are none, and a dead bond's pair may be bonded again
-  if (s.bonds.n + s.frozen_bonds.n > 0)
+  if (s.bonds.n - s.cache.dead_bonds.size() + s.frozen_bonds.n > 0)  // dead bonds are none
     require(s.bonds.material == material,
             "install_bonds: the world already holds bonds of another material (one bond material "
             "per world)");
@@ -44,6 +43,7 @@ std::size_t World::install_bonds(const BondMaterial& given, double tolerance,
     tolerance = 1e-3 * mean / double(p.n);
   }
   for (auto id : ids) index_of(s, id);  // every id valid before anything changes
+  detail::compact_bonds(s);  // a dead bond's pair may be bonded again
   const std::size_t installed = detail::install_bonds(s, material, tolerance, ids, stress_free);
   changed(s, Change::particles);  // bonded pairs leave the contact list
   return installed;

@@ -1450,3 +1450,20 @@ TEST(Bonds, TheServoCountsAfterBreaksAreTheOnesTakenAfresh) {
   EXPECT_GT(kept_steps, 10u);
   EXPECT_LT(w.state().cache.servo.bond_ends[std::size_t(top)], ends_before) << "bonds to the platen broke";
 }
+
+// A world whose bonds all broke holds none, even while they wait dead for the next build: it takes
+// bonds of another material, as one whose list was emptied would.
+TEST(Bonds, AWorldWhoseBondsAllBrokeTakesBondsOfAnotherMaterial) {
+  BondMaterial bm;
+  bm.tensile_strength = 2.0;
+  bm.contact_strength = 0;  // the contact bond breaks with the beam
+  Pair p = bonded_pair(bm, moving({0, 0, 1e-6}));
+  while (p.w.break_events().empty() && p.w.step_count() < 1000000) p.w.cycle(1);
+  ASSERT_EQ(p.w.bond_count(), 0u);
+  ASSERT_EQ(p.w.state().cache.dead_bonds.size(), 1u) << "the bond waits dead in the list";
+  BondMaterial other;
+  other.tensile_strength = 5.0;
+  EXPECT_EQ(test::error_of([&] { p.w.install_bonds(other, 1.0); }), "(no error)");
+  EXPECT_EQ(p.w.bonds().size(), 1u) << "the pair, within the tolerance, bonded again";
+  EXPECT_TRUE(p.w.state().cache.dead_bonds.empty());
+}
