@@ -1,9 +1,11 @@
 // Small scenes and helpers shared by the engine's tests.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <random>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "asperity/world.hpp"
 
@@ -59,6 +61,43 @@ inline World random_box(int n, WorldSettings ws = {}, unsigned seed = 1, double 
   w.add_plane({0, L, 0}, {0, -1, 0});
   w.add_plane({0, 0, lift + 2 * L + double(n / (side * side)) * cell}, {0, 0, -1});
   return w;
+}
+
+// n x n x `layers` spheres of diameter d on a grid of pitch 0.99 d (neighbours overlap by 1 %),
+// between two platens: the bottom layer a fixed group, the top one a group sheared along x at
+// `velocity` under a servo holding `load` along z. `prepare(world, first_id)` runs before the
+// platens are made (velocities, bonds).
+struct ShearedLayers {
+  World w;
+  int top = -1;
+};
+inline ShearedLayers sheared_layers(WorldSettings ws, int n, int layers, double d, double velocity, double load,
+                                    const std::function<void(World&, std::int64_t)>& prepare = {}) {
+  ShearedLayers out{World(ws)};
+  World& w = out.w;
+  const double a = 0.99 * d;
+  std::vector<double> xyz;
+  for (int k = 0; k < layers; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        for (double c : {(i + 0.5) * a, (j + 0.5) * a, (k + 0.5) * a}) xyz.push_back(c);
+  const std::int64_t first = w.add_particles(xyz, std::vector<double>(xyz.size() / 3, 0.5 * d));
+  if (prepare) prepare(w, first);
+  std::vector<std::int64_t> bottom, upper;
+  for (std::int64_t k = 0; k < std::int64_t(xyz.size() / 3); ++k) {
+    const std::int64_t layer = k / (n * n);
+    if (layer == 0) bottom.push_back(first + k);
+    if (layer == layers - 1) upper.push_back(first + k);
+  }
+  GroupMotion held;
+  held.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
+  w.add_group(bottom, held);
+  GroupMotion shear;
+  shear.translation = {Dof::velocity, Dof::fixed, Dof::servo};
+  shear.velocity = {velocity, 0, 0};
+  shear.servo[2].target_force = load;
+  out.top = w.add_group(upper, shear);
+  return out;
 }
 
 // random_box(600) settled, then bonded with a strength low enough that bonds break as it goes on

@@ -1393,37 +1393,18 @@ TEST(Bonds, ABadBondMaterialIsRefusedByNameAndNothingIsInstalled) {
 // with the counts taken afresh at every step: the platens' stiffness and every particle's motion
 // bit for bit, with bonds joining the platens to the block broken on the way.
 TEST(Bonds, TheServoCountsAfterBreaksAreTheOnesTakenAfresh) {
-  constexpr int n = 10, layers = 6;
-  constexpr double d = 1e-3, a = 0.99 * d;
-  auto make = [&](int& top) {
+  auto make = [](int& top) {
     WorldSettings ws;
     ws.dt = 5e-4;
-    World w(ws);
-    std::vector<double> xyz;
-    for (int k = 0; k < layers; ++k)
-      for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i)
-          for (double c : {(i + 0.5) * a, (j + 0.5) * a, (k + 0.5) * a}) xyz.push_back(c);
-    const std::int64_t first = w.add_particles(xyz, std::vector<double>(xyz.size() / 3, 0.5 * d));
-    std::vector<std::int64_t> bottom, upper;
-    for (std::int64_t k = 0; k < std::int64_t(xyz.size() / 3); ++k) {
-      const std::int64_t layer = k / (n * n);
-      if (layer == 0) bottom.push_back(first + k);
-      if (layer == layers - 1) upper.push_back(first + k);
-    }
-    BondMaterial bm;
-    bm.tensile_strength = 0.05;
-    bm.contact_strength = 0.5;
-    w.install_bonds(bm);
-    GroupMotion held;
-    held.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
-    w.add_group(bottom, held);
-    GroupMotion shear;
-    shear.translation = {Dof::velocity, Dof::fixed, Dof::servo};
-    shear.velocity = {2e-3, 0, 0};
-    shear.servo[2].target_force = 1e-6;
-    top = w.add_group(upper, shear);
-    return w;
+    auto bond = [](World& w, std::int64_t) {
+      BondMaterial bm;
+      bm.tensile_strength = 0.05;
+      bm.contact_strength = 0.5;
+      w.install_bonds(bm);
+    };
+    test::ShearedLayers box = test::sheared_layers(ws, 10, 6, 1e-3, 2e-3, 1e-6, bond);
+    top = box.top;
+    return std::move(box.w);
   };
   int top = -1, top_afresh = -1;
   World w = make(top), afresh = make(top_afresh);

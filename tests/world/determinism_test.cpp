@@ -91,35 +91,19 @@ TEST(Determinism, SpheresOnAStillMouldAreTheSameOnOneAndTwoThreads) {
 // particles, the platens' forces and positions, and the ledgers the group stages add to.
 TEST(Determinism, PlatensMovedInTheParallelRegionAreTheSameOnOneAndTwoThreads) {
   constexpr int n = 24, layers = 6;
-  constexpr double d = 1e-3, a = 0.99 * d;
   auto make = [&](int threads, int& top) {
     WorldSettings ws;
     ws.threads = threads;
-    World w(ws);
-    std::vector<double> xyz;
-    for (int k = 0; k < layers; ++k)
-      for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i)
-          for (double c : {(i + 0.5) * a, (j + 0.5) * a, (k + 0.5) * a}) xyz.push_back(c);
-    const std::int64_t first = w.add_particles(xyz, std::vector<double>(xyz.size() / 3, 0.5 * d));
-    std::mt19937_64 rng(77);
-    std::normal_distribution<double> jiggle(0, 1e-6);
-    std::vector<std::int64_t> bottom, upper;
-    for (std::int64_t k = 0; k < std::int64_t(xyz.size() / 3); ++k) {
-      const std::int64_t layer = k / (n * n);
-      if (layer == 0) bottom.push_back(first + k);
-      else if (layer == layers - 1) upper.push_back(first + k);
-      else w.set_velocity(first + k, {jiggle(rng), jiggle(rng), jiggle(rng)});
-    }
-    GroupMotion held;
-    held.translation = {Dof::fixed, Dof::fixed, Dof::fixed};
-    w.add_group(bottom, held);
-    GroupMotion shear;
-    shear.translation = {Dof::velocity, Dof::fixed, Dof::servo};
-    shear.velocity = {2e-4, 0, 0};
-    shear.servo[2].target_force = 1e-3;
-    top = w.add_group(upper, shear);
-    return w;
+    // The layers between the platens jiggled.
+    auto jiggle_inside = [](World& w, std::int64_t first) {
+      std::mt19937_64 rng(77);
+      std::normal_distribution<double> jiggle(0, 1e-6);
+      for (std::int64_t k = n * n; k < std::int64_t(n * n * (layers - 1)); ++k)
+        w.set_velocity(first + k, {jiggle(rng), jiggle(rng), jiggle(rng)});
+    };
+    test::ShearedLayers box = test::sheared_layers(ws, n, layers, 1e-3, 2e-4, 1e-3, jiggle_inside);
+    top = box.top;
+    return std::move(box.w);
   };
   int top1 = -1, top2 = -1;
   World one = make(1, top1), two = make(2, top2);
