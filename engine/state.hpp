@@ -88,6 +88,11 @@ struct Caches {
   // is redone at every neighbour build and after the API changes motions or applied forces).
   std::vector<std::uint8_t> idle;
   bool idle_valid = false;
+  // The split went stale only because a break step merged freed pairs into the list
+  // (insert_pairs) since it was made: the groups, their laziness and the bonds that may be
+  // frozen are as they were, so the next split need not look for bonds to freeze or thaw. Cleared
+  // by every other change (changed(), a neighbour build).
+  bool idle_pairs_only = false;
   // Per particle block (kParticleBlock): whether it holds a free particle (to integrate), and for
   // the blocks that do not, their busy group members (the only ones the gather has to visit).
   std::vector<std::uint8_t> block_free;
@@ -171,6 +176,7 @@ enum class Change {
   added,           // new particles: a reorder at the next build
 };
 inline void changed(State& s, Change c) {
+  s.cache.idle_pairs_only = false;  // the next split looks at everything
   switch (c) {
     case Change::particles:
       s.need_rebuild = true;  // the rebuild also redoes the busy / idle split of the groups

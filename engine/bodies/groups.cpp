@@ -37,8 +37,11 @@ void sync_lazy(State& s) {
 void split_idle(State& s) {
   sync_lazy(s);
   for (Group& g : s.groups) g.lazy = g.motion.rotation == Dof::fixed && g.angular_velocity == Vec3{};
-  // The bonds inside lazy groups leave the step first: a member held only by them is idle.
-  settle_frozen_bonds(s);
+  // The bonds inside lazy groups leave the step first: a member held only by them is idle. After
+  // a break step's merge alone there are none to move (Caches::idle_pairs_only): a group of fixed
+  // rotation never turns, so laziness changes only through the API, and a break adds no bond.
+  if (!s.cache.idle_pairs_only) settle_frozen_bonds(s);
+  s.cache.idle_pairs_only = false;
   ParticleStore& p = s.p;
   s.cache.idle.assign(p.n, 0);
   const Incidence &inc = s.incidence, &binc = s.cache.bond_incidence;

@@ -529,6 +529,7 @@ void build_neighbors(State& s) {
   ++s.rebuilds;
   ++s.rebuilds_since_reorder;
   s.need_rebuild = false;
+  s.cache.idle_pairs_only = false;  // the groups' members may have moved between bodies' reach
   split_idle(s);
 }
 
@@ -630,6 +631,7 @@ void insert_pairs(State& s, const PairStore& add) {
       if (group[add.a[j]] != group[add.b[j]]) listed.push_back(std::uint32_t(at[j] + j));
     servo.pairs.swap(listed);
   }
+  s.cache.idle_pairs_only = s.cache.idle_valid || s.cache.idle_pairs_only;
   s.cache.idle_valid = false;  // a member may have a pair now
 }
 

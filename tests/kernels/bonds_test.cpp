@@ -1392,22 +1392,28 @@ TEST(Bonds, ABadBondMaterialIsRefusedByNameAndNothingIsInstalled) {
 // bonded block sheared between two platens, its top one under the servo, against the same run
 // with the counts taken afresh at every step: the platens' stiffness and every particle's motion
 // bit for bit, with bonds joining the platens to the block broken on the way.
-TEST(Bonds, TheServoCountsAfterBreaksAreTheOnesTakenAfresh) {
-  auto make = [](int& top) {
-    WorldSettings ws;
-    ws.dt = 5e-4;
-    auto bond = [](World& w, std::int64_t) {
-      BondMaterial bm;
-      bm.tensile_strength = 0.05;
-      bm.contact_strength = 0.5;
-      w.install_bonds(bm);
-    };
-    test::ShearedLayers box = test::sheared_layers(ws, 10, 6, 1e-3, 2e-3, 1e-6, bond);
-    top = box.top;
-    return std::move(box.w);
+namespace {
+// A bonded block sheared between two platens (test::sheared_layers), its top one under the servo:
+// contact bonds breaking apart at 0.5 st A, bonds to the platens among them; the bonds inside each
+// platen frozen (the platens do not turn).
+World bonded_sheared_block(int& top) {
+  WorldSettings ws;
+  ws.dt = 5e-4;
+  auto bond = [](World& w, std::int64_t) {
+    BondMaterial bm;
+    bm.tensile_strength = 0.05;
+    bm.contact_strength = 0.5;
+    w.install_bonds(bm);
   };
+  test::ShearedLayers box = test::sheared_layers(ws, 10, 6, 1e-3, 2e-3, 1e-6, bond);
+  top = box.top;
+  return std::move(box.w);
+}
+}  // namespace
+
+TEST(Bonds, TheServoCountsAfterBreaksAreTheOnesTakenAfresh) {
   int top = -1, top_afresh = -1;
-  World w = make(top), afresh = make(top_afresh);
+  World w = bonded_sheared_block(top), afresh = bonded_sheared_block(top_afresh);
   std::size_t kept_steps = 0;
   const std::uint32_t ends_before = [&] {
     w.cycle(1);
@@ -1447,4 +1453,24 @@ TEST(Bonds, AWorldWhoseBondsAllBrokeTakesBondsOfAnotherMaterial) {
   EXPECT_EQ(test::error_of([&] { p.w.install_bonds(other, 1.0); }), "(no error)");
   EXPECT_EQ(p.w.bonds().size(), 1u) << "the pair, within the tolerance, bonded again";
   EXPECT_TRUE(p.w.state().cache.dead_bonds.empty());
+}
+
+// A break step's freed pairs make the idle split of the platens stale; the next split need not
+// look for bonds to freeze or thaw (Caches::idle_pairs_only): against the same run with a full
+// split after every break step, every motion bit for bit and the frozen bonds the same.
+TEST(Bonds, ASplitAfterABreakStepAloneLeavesTheFrozenBondsAsTheyAre) {
+  int top = -1, top_full = -1;
+  World w = bonded_sheared_block(top), full = bonded_sheared_block(top_full);
+  std::size_t pairs_only = 0;
+  for (int step = 0; step < 600; ++step) {
+    w.cycle(1);
+    full.cycle(1);
+    pairs_only += w.state().cache.idle_pairs_only;
+    full.state().cache.idle_pairs_only = false;
+    ASSERT_TRUE(same_bits(motion_of(w), motion_of(full))) << "step " << w.step_count();
+  }
+  EXPECT_GT(pairs_only, 10u);
+  EXPECT_GT(w.state().frozen_bonds.n, 0u);
+  EXPECT_EQ(w.state().frozen_bonds.n, full.state().frozen_bonds.n);
+  EXPECT_EQ(w.bond_count(), full.bond_count());
 }
