@@ -98,8 +98,7 @@ void process_breaks(State& s) {
     return;
   }
   // Only the bond stage's blocks that flagged a break are looked at (bond_stage's blocks).
-  std::vector<double> block_breaks;
-  block_breaks.swap(s.ctx.bond_block_breaks);
+  const std::vector<double>& block_breaks = s.ctx.bond_block_breaks;
   const std::size_t block = pair_block_size(q.padded);
   const ParticleStore& p = s.p;
   // The broken bonds are handled in place; those of which nothing holds any more stay in their
@@ -210,8 +209,7 @@ void process_breaks(State& s) {
     }
   }
   freed.resize(nfreed);
-  block_breaks.clear();
-  block_breaks.swap(s.ctx.bond_block_breaks);  // its storage back for the next step
+  s.ctx.bond_block_breaks.clear();
   refresh_bond_topology_after_breaks(s, losses);
   // Into the pair list without a rebuild: a fracture run breaks bonds on most of its steps, and a
   // rebuild for each would rebuild the list (and reorder the particles) nearly every step.

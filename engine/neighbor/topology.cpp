@@ -74,6 +74,18 @@ void retire_entry(Incidence& inc, std::size_t i, std::size_t k, int side, std::i
     }
 }
 
+// A new bond_version (the bonds' indices or states changed) for a change after which the servo's
+// count of bond ends joining two bodies (Caches::servo), if it was current, stays current once
+// the ends of the bonds in `gone_ends` (a, b in pairs) are counted out.
+void new_bond_version(State& s, const std::vector<std::int64_t>& gone_ends) {
+  ServoContacts& servo = s.cache.servo;
+  const bool current = servo.bonds_of == s.bond_version;
+  ++s.bond_version;
+  if (!current) return;
+  for (std::size_t e = 0; e < gone_ends.size(); e += 2) servo.count_bond_ends(s.p.group, gone_ends[e], gone_ends[e + 1], -1);
+  servo.bonds_of = s.bond_version;
+}
+
 // Whether particle i still holds a bond the step computes (an entry not retired).
 bool holds_live_bond(const Incidence& inc, std::size_t i, std::int64_t zero) {
   for (std::int32_t e = inc.start[i]; e < inc.start[i + 1]; ++e)
@@ -147,20 +159,8 @@ void refresh_bond_topology_after_breaks(State& s, const BondLosses& losses) {
   if (losses.gone.empty() && losses.beam_ends.empty() && !losses.partial_left) return;
   BondStore& q = s.bonds;
   Caches& c = s.cache;
-  // The servo's count of bond ends joining two bodies, if current, loses the dead bonds' ends.
-  const bool servo_current = c.servo.bonds_of == s.bond_version;
-  ++s.bond_version;
+  new_bond_version(s, losses.gone_ends);  // the dead bonds' ends leave the servo's count
   c.spin_known = false;
-  if (servo_current) {
-    const auto& group = s.p.group;
-    for (std::size_t e = 0; e < losses.gone_ends.size(); e += 2) {
-      const auto a = std::size_t(losses.gone_ends[e]), b = std::size_t(losses.gone_ends[e + 1]);
-      if (group[a] == group[b]) continue;
-      for (const std::size_t i : {a, b})
-        if (group[i] >= 0) --c.servo.bond_ends[std::size_t(group[i])];
-    }
-    c.servo.bonds_of = s.bond_version;
-  }
   if (!losses.gone.empty()) {
     // The bonds of which nothing holds stay in their slots, dead (BondStore::dead), until the next
     // neighbour build takes them out (compact_bonds): their entries point at the zero record.
@@ -211,10 +211,7 @@ void compact_bonds(State& s) {
   // The same incidence as the breaks' retired one without its retired entries: every other count
   // and flag of the bonds (bonded particles, partners, partial bonds, locks) is already current.
   build_incidence(s.p.n, q.a.data(), q.b.data(), q.n, c.bond_incidence);
-  // Bond indices moved (bond_version); the servo's count of bond ends does not change.
-  const bool servo_current = c.servo.bonds_of == s.bond_version;
-  ++s.bond_version;
-  if (servo_current) c.servo.bonds_of = s.bond_version;
+  new_bond_version(s, {});  // bond indices moved; the servo's count of bond ends stays
 }
 
 }  // namespace asperity::detail

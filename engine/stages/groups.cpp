@@ -218,12 +218,8 @@ void update_servo_stiffness(const GroupStageView& s) {
   }
   if (s.servo.bonds_of != s.bond_version) {
     s.servo.bond_ends.assign(s.groups.size(), 0);
-    for (std::size_t k = 0; k < s.bonds.n; ++k) {
-      const std::int64_t a = s.bonds.a[k], b = s.bonds.b[k];
-      if (s.bonds.dead(k) || p.group[a] == p.group[b]) continue;
-      for (const std::int64_t i : {a, b})
-        if (p.group[i] >= 0) ++s.servo.bond_ends[std::size_t(p.group[i])];
-    }
+    for (std::size_t k = 0; k < s.bonds.n; ++k)
+      if (!s.bonds.dead(k)) s.servo.count_bond_ends(p.group, s.bonds.a[k], s.bonds.b[k], 1);
     s.servo.bonds_of = s.bond_version;
   }
   std::vector<double> K(s.groups.size(), 0.0);

@@ -45,6 +45,15 @@ struct ServoContacts {
   std::vector<std::uint32_t> bond_ends;
   std::uint64_t pairs_at = ~std::uint64_t(0);
   std::uint64_t bonds_of = ~std::uint64_t(0);
+
+  // Bond (a, b), if it joins two bodies, counted into bond_ends at each end that is in a group,
+  // `by` times (+1 taken, -1 gone).
+  template <class Groups>
+  void count_bond_ends(const Groups& group, std::int64_t a, std::int64_t b, int by) {
+    if (group[a] == group[b]) return;
+    for (const std::int64_t i : {a, b})
+      if (group[i] >= 0) bond_ends[std::size_t(group[i])] += std::uint32_t(by);
+  }
 };
 
 }  // namespace asperity::detail
