@@ -12,6 +12,7 @@
 #include "asperity/world.hpp"
 #include "core/load.hpp"
 #include "kernels/kernels.hpp"
+#include "neighbor/cell_grid.hpp"
 #include "store/bonds.hpp"
 #include "store/groups.hpp"
 #include "store/pairs.hpp"
@@ -84,6 +85,7 @@ struct Caches {
   // break).
   PairStore freed_pairs, spare_pairs;
   std::vector<std::vector<std::int32_t>> found_pairs;  // a neighbour build's, per chunk of particles
+  CellGrid grid;  // the last neighbour build's cells (neighbor/cell_grid.hpp)
   // Idle group members (see Group::busy), per particle index; valid while idle_valid (the split
   // is redone at every neighbour build and after the API changes motions or applied forces).
   std::vector<std::uint8_t> idle;

@@ -4,6 +4,7 @@
 #pragma once
 #include "kernels/bond_loop.hpp"
 #include "kernels/integrate_loop.hpp"
+#include "kernels/near_loop.hpp"
 #include "kernels/pair_loop.hpp"
 #include "kernels/wall_loop.hpp"
 
@@ -23,7 +24,8 @@ KernelSet loop_kernels(const char* name, GatherKernel gather) {
           &integrate_loop<Lanes, false>,
           &plane_wall_loop<Lanes, true>,
           &plane_wall_loop<Lanes, false>,
-          gather};
+          gather,
+          &near_loop<Lanes>};
 }
 
 }  // namespace asperity::kernels

@@ -200,6 +200,21 @@ struct IntegrateSums {
 using IntegrateKernel = void (*)(const IntegrateArgs&, std::size_t begin, std::size_t end,
                                  IntegrateSums& out);
 
+// Neighbour search (neighbor/build.cpp, model.md 6): of the entries [first, last) of cell-ordered
+// columns (centre x, y, z, radius r and particle index; readable to last + kMaxLanes), the ones
+// of an index above `after` within reach of a centre: (x - cx)^2 + (y - cy)^2 + (z - cz)^2 <
+// (reach + r)^2, each difference and sum taken in that order. Writes their positions, ascending,
+// to hits (room for last - first) and returns how many.
+struct NearArgs {
+  const double* x; const double* y; const double* z; const double* r;
+  const std::int32_t* index;
+  double cx, cy, cz, reach;
+  std::int32_t after;
+};
+
+using NearKernel = std::size_t (*)(const NearArgs&, std::int32_t first, std::int32_t last,
+                                   std::int32_t* hits);
+
 struct KernelSet {
   const char* name;        // "scalar", "sse4_2", "avx2", "avx512f"
   std::size_t lanes;       // doubles per batch
@@ -215,6 +230,7 @@ struct KernelSet {
   PlaneWallKernel plane_walls;       // with rotation
   PlaneWallKernel plane_walls_norot;
   GatherKernel gather;
+  NearKernel near;
 };
 
 const KernelSet& scalar_kernels();

@@ -31,6 +31,7 @@ struct ScalarLanes {
   }
   static double iota(double start) { return start; }
   static double lane(double v, std::size_t) { return v; }
+  static std::uint64_t bits(bool v) { return v; }  // near_loop.hpp
 };
 
 }  // namespace

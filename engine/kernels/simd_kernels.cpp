@@ -197,6 +197,25 @@ struct SimdLanes {
     for (std::size_t j = 0; j < size; ++j) l[j] = start + double(j);
     return Real::load_aligned(l);
   }
+  // Bit j set where lane j holds (near_loop.hpp).
+  static std::uint64_t bits(const xsimd::batch_bool<double, Arch>& m) {
+#if defined(__AVX512F__)
+    return std::uint64_t(__mmask8(m));  // the batch_bool is the mask register
+#elif defined(__AVX2__)
+    return std::uint64_t(unsigned(_mm256_movemask_pd(m)));
+#else
+    return std::uint64_t(unsigned(_mm_movemask_pd(m)));
+#endif
+  }
+  static std::uint64_t bits(const xsimd::batch_bool<std::int64_t, Arch>& m) {
+#if defined(__AVX512F__)
+    return std::uint64_t(__mmask8(m));
+#elif defined(__AVX2__)
+    return std::uint64_t(unsigned(_mm256_movemask_pd(_mm256_castsi256_pd(m))));
+#else
+    return std::uint64_t(unsigned(_mm_movemask_pd(_mm_castsi128_pd(m))));
+#endif
+  }
   static double lane(const Real& v, std::size_t j) {
     alignas(64) double l[size];
     v.store_aligned(l);

@@ -32,6 +32,7 @@
 
 #include "bodies/groups.hpp"
 #include "bodies/mesh.hpp"
+#include "core/aligned.hpp"
 #include "neighbor/build.hpp"
 #include "neighbor/topology.hpp"
 #include "state.hpp"
@@ -40,33 +41,8 @@ namespace asperity::detail {
 
 namespace {
 
-struct CellGrid {
-  double ox = 0, oy = 0, oz = 0, cell = 1;
-  int nx = 1, ny = 1, nz = 1;
-  std::vector<std::int32_t> cell_of;   // per particle
-  std::vector<std::int32_t> start;     // per cell + 1
-  std::vector<std::int32_t> members;   // particle indices, by cell, ascending within a cell
-  // Per cell: the rigid group all its particles belong to; -1 where one is free or the cell is
-  // empty, -2 where it holds members of two groups. A member's search skips the cells of its own
-  // group, which hold no pair for it: in a rigid joint that is most of the cells it looks at.
-  std::vector<std::int32_t> group_of_cell;
-
-  int clampi(double v, int n) const {
-    const double c = std::floor(v / cell);
-    // Compared as doubles first: a cast of a value outside int's range is undefined.
-    if (!(c > 0)) return 0;
-    if (c >= double(n - 1)) return n - 1;
-    return static_cast<int>(c);
-  }
-  void coords(double x, double y, double z, int& i, int& j, int& k) const {
-    i = clampi(x - ox, nx);
-    j = clampi(y - oy, ny);
-    k = clampi(z - oz, nz);
-  }
-};
-
-CellGrid make_grid(const ParticleStore& p, double skin, std::uint64_t step) {
-  CellGrid g;
+// The cells of the particles as they are now, written into g (its columns keep their pages).
+void make_grid(const ParticleStore& p, double skin, std::uint64_t step, CellGrid& g) {
   const std::size_t n = p.n;
   double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, rmax = 0;
   for (std::size_t i = 0; i < n; ++i) {
@@ -125,10 +101,28 @@ CellGrid make_grid(const ParticleStore& p, double skin, std::uint64_t step) {
     ++binned;
   }
   std::partial_sum(g.start.begin(), g.start.end(), g.start.begin());
-  g.members.resize(binned);
+  g.members.resize(binned + kMaxLanes);
   std::vector<std::int32_t> fill(g.start.begin(), g.start.end() - 1);
   for (std::size_t i = 0; i < n; ++i)
     if (g.cell_of[i] >= 0) g.members[fill[g.cell_of[i]]++] = std::int32_t(i);
+  for (auto* column : {&g.mx, &g.my, &g.mz, &g.mr}) column->resize(binned + kMaxLanes);
+  for (std::size_t t = 0; t < binned; ++t) {
+    const auto i = std::size_t(g.members[t]);
+    g.mx[t] = p.x[i];
+    g.my[t] = p.y[i];
+    g.mz[t] = p.z[i];
+    g.mr[t] = p.radius[i];
+  }
+  for (std::size_t t = binned; t < binned + kMaxLanes; ++t) {
+    g.mx[t] = g.my[t] = g.mz[t] = g.mr[t] = 0;
+    g.members[t] = -1;
+  }
+  g.longest_row = 0;
+  for (std::size_t row = 0; row < cells; row += std::size_t(g.nx))
+    for (int m = 0; m < g.nx; ++m) {
+      const std::size_t last = row + std::size_t(std::min(m + 2, g.nx - 1)) + 1;
+      g.longest_row = std::max(g.longest_row, g.start[last] - g.start[row + std::size_t(m)]);
+    }
   g.group_of_cell.assign(cells, -1);
   for (std::size_t c = 0; c < cells; ++c) {
     if (g.start[c] == g.start[c + 1]) continue;
@@ -137,7 +131,6 @@ CellGrid make_grid(const ParticleStore& p, double skin, std::uint64_t step) {
       if (p.group[std::size_t(g.members[std::size_t(t)])] != common) common = -2;
     g.group_of_cell[c] = common;
   }
-  return g;
 }
 
 inline constexpr std::size_t kRasterFrom = 20000;  // particles (design notes)
@@ -299,30 +292,46 @@ inline bool bonded(const State& s, std::size_t i, std::int32_t o) {
   return first != last && std::binary_search(first, last, o);
 }
 
-// The j > i within reach of particle i, ascending.
+// The j > i within reach of particle i, in the order of its cells (the caller sorts them). The
+// three cells of a row are adjacent in `members`, so each row is one run (less the cells that
+// hold only i's own group), which the kernel reads as columns: dx^2 + dy^2 + dz^2 < (Ri + skin +
+// Rj)^2 with d = xj - xi, the test of every search before, so the list is the same. Only its few
+// hits (bonded partners touch: they are among them) ask for j > i, the group and the partners.
+// `hits` has room for the longest row.
 template <class Out>
-void neighbours_of(const State& s, const CellGrid& g, std::size_t i, Out&& out) {
+void neighbours_of(const State& s, const CellGrid& g, std::size_t i, std::int32_t* hits, Out&& out) {
   const ParticleStore& p = s.p;
   if (p.inert[i]) return;
   int ci, cj, ck;
   g.coords(p.x[i], p.y[i], p.z[i], ci, cj, ck);
-  const double reach = p.radius[i] + s.skin;
+  const kernels::NearArgs args{g.mx.data(), g.my.data(), g.mz.data(), g.mr.data(), g.members.data(),
+                               p.x[i], p.y[i], p.z[i], p.radius[i] + s.skin, std::int32_t(i)};
   const std::int32_t gi = p.group[i];
+  auto own = [&](std::size_t cell) { return gi >= 0 && g.group_of_cell[cell] == gi; };
+  auto run = [&](std::int32_t first, std::int32_t last) {
+    const std::size_t found = s.ctx.kernels->near(args, first, last, hits);
+    for (std::size_t h = 0; h < found; ++h) {
+      const std::int32_t o = g.members[std::size_t(hits[h])];
+      if (gi >= 0 && p.group[o] == gi) continue;
+      if (bonded(s, i, o)) continue;
+      out(o);
+    }
+  };
+  const int m0 = std::max(ci - 1, 0), m1 = std::min(ci + 1, g.nx - 1);
   for (int k = std::max(ck - 1, 0); k <= std::min(ck + 1, g.nz - 1); ++k)
-    for (int j = std::max(cj - 1, 0); j <= std::min(cj + 1, g.ny - 1); ++j)
-      for (int m = std::max(ci - 1, 0); m <= std::min(ci + 1, g.nx - 1); ++m) {
-        const std::size_t cell = (std::size_t(k) * g.ny + j) * g.nx + m;
-        if (gi >= 0 && g.group_of_cell[cell] == gi) continue;
-        for (std::int32_t t = g.start[cell]; t < g.start[cell + 1]; ++t) {
-          const std::int32_t o = g.members[t];
-          if (std::size_t(o) <= i) continue;
-          if (gi >= 0 && p.group[o] == gi) continue;
-          if (bonded(s, i, o)) continue;
-          const double dx = p.x[o] - p.x[i], dy = p.y[o] - p.y[i], dz = p.z[o] - p.z[i];
-          const double cut = reach + p.radius[o];
-          if (dx * dx + dy * dy + dz * dz < cut * cut) out(o);
+    for (int j = std::max(cj - 1, 0); j <= std::min(cj + 1, g.ny - 1); ++j) {
+      const std::size_t row = (std::size_t(k) * g.ny + j) * g.nx;
+      for (int m = m0; m <= m1;) {
+        if (own(row + m)) {
+          ++m;
+          continue;
         }
+        int e = m;
+        while (e < m1 && !own(row + e + 1)) ++e;
+        run(g.start[row + m], g.start[row + e + 1]);
+        m = e + 1;
       }
+    }
 }
 
 void build_pairs(State& s, const CellGrid& g) {
@@ -333,16 +342,21 @@ void build_pairs(State& s, const CellGrid& g) {
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
   std::vector<std::vector<std::int32_t>>& found = s.cache.found_pairs;
   found.resize(chunks);
-  std::vector<std::int64_t> count(n + 1, 0);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(thread_count(s))
-  for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
-    std::vector<std::int32_t>& list = found[chunk];
-    list.clear();
-    for (std::size_t i = chunk * kChunk; i < std::min(n, (chunk + 1) * kChunk); ++i) {
-      const std::size_t first = list.size();
-      neighbours_of(s, g, i, [&](std::int32_t o) { list.push_back(o); });
-      std::sort(list.begin() + std::ptrdiff_t(first), list.end());
-      count[i + 1] = std::int64_t(list.size() - first);
+  std::vector<std::int64_t>& count = s.cache.grid.pair_count;
+  count.assign(n + 1, 0);
+#pragma omp parallel num_threads(thread_count(s))
+  {
+    std::vector<std::int32_t> hits(std::size_t(g.longest_row));
+#pragma omp for schedule(dynamic, 1)
+    for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
+      std::vector<std::int32_t>& list = found[chunk];
+      list.clear();
+      for (std::size_t i = chunk * kChunk; i < std::min(n, (chunk + 1) * kChunk); ++i) {
+        const std::size_t first = list.size();
+        neighbours_of(s, g, i, hits.data(), [&](std::int32_t o) { list.push_back(o); });
+        std::sort(list.begin() + std::ptrdiff_t(first), list.end());
+        count[i + 1] = std::int64_t(list.size() - first);
+      }
     }
   }
   std::partial_sum(count.begin(), count.end(), count.begin());
@@ -509,11 +523,12 @@ void build_neighbors(State& s) {
   compact_bonds(s);  // the bonds that broke since the last build leave the list (before a reorder)
   sync_lazy(s);  // idle group members are searched: bring them to where they are
   ensure_skin(s);
-  CellGrid grid = make_grid(p, s.skin, s.step);
+  CellGrid& grid = s.cache.grid;
+  make_grid(p, s.skin, s.step, grid);
   const int every = s.settings.reorder_interval;
   if (p.n > 0 && (s.force_reorder || (every > 0 && s.rebuilds_since_reorder >= std::uint64_t(every)))) {
     reorder(s, grid);
-    grid = make_grid(p, s.skin, s.step);
+    make_grid(p, s.skin, s.step, grid);
     s.rebuilds_since_reorder = 0;
     s.force_reorder = false;
   }

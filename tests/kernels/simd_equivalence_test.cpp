@@ -764,3 +764,43 @@ TEST(KernelEquivalence, GatherSkipsDeadPairRecordsBitwise) {
     }
 }
 
+
+// The neighbour search's kernel (near_loop.hpp): runs of every length from every start over
+// random columns (centres near and far, a NaN centre, indices on both sides of `after`), on every
+// architecture, find the entries a plain loop with the same test finds, in the same order.
+TEST(KernelEquivalence, NeighbourRunKernelFindsWhatAPlainLoopFinds) {
+  constexpr std::int32_t n = 64;
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<double> x(n + kMaxLanes, 0.0), y(x), z(x), r(x);
+  std::vector<std::int32_t> index(n + kMaxLanes, -1);
+  for (std::int32_t t = 0; t < n; ++t) {
+    x[t] = 1.2e-3 * u(rng); y[t] = 1.2e-3 * u(rng); z[t] = 1.2e-3 * u(rng);
+    r[t] = 5e-4 * (1 + 0.5 * u(rng));
+    index[t] = std::int32_t(rng() % 100);
+  }
+  x[17] = std::numeric_limits<double>::quiet_NaN();
+  const kernels::NearArgs args{x.data(), y.data(), z.data(), r.data(), index.data(), 1e-4, -2e-4, 3e-4, 6e-4, 50};
+  auto plain = [&](std::int32_t first, std::int32_t last) {
+    std::vector<std::int32_t> out;
+    for (std::int32_t t = first; t < last; ++t) {
+      const double dx = x[t] - args.cx, dy = y[t] - args.cy, dz = z[t] - args.cz;
+      const double cut = args.reach + r[t];
+      if (dx * dx + dy * dy + dz * dz < cut * cut && index[t] > args.after) out.push_back(t);
+    }
+    return out;
+  };
+  EXPECT_GT(plain(0, n).size(), 3u);
+  EXPECT_LT(plain(0, n).size(), std::size_t(n) / 2);
+  std::vector<const kernels::KernelSet*> sets{&kernels::scalar_kernels()};
+  for (const auto& arch : available_simd_architectures()) sets.push_back(&kernels::select_kernels(arch));
+  std::vector<std::int32_t> hits(n);
+  for (const auto* set : sets)
+    for (std::int32_t first = 0; first <= n; ++first)
+      for (std::int32_t last = first; last <= n; ++last) {
+        const std::size_t found = set->near(args, first, last, hits.data());
+        const std::vector<std::int32_t> want = plain(first, last);
+        ASSERT_EQ(std::vector<std::int32_t>(hits.begin(), hits.begin() + std::ptrdiff_t(found)), want)
+            << set->name << " [" << first << ", " << last << ")";
+      }
+}
