@@ -200,11 +200,12 @@ struct IntegrateSums {
 using IntegrateKernel = void (*)(const IntegrateArgs&, std::size_t begin, std::size_t end,
                                  IntegrateSums& out);
 
-// Neighbour search (neighbor/build.cpp, model.md 6): of the entries [first, last) of cell-ordered
-// columns (centre x, y, z, radius r and particle index; readable to last + kMaxLanes), the ones
-// of an index above `after` within reach of a centre: (x - cx)^2 + (y - cy)^2 + (z - cz)^2 <
-// (reach + r)^2, each difference and sum taken in that order. Writes their positions, ascending,
-// to hits (room for last - first) and returns how many.
+// Neighbour search (neighbor/build.cpp, model.md 6): of the entries of cell-ordered columns
+// (centre x, y, z, radius r and particle index; readable kMaxLanes entries past any run) in the
+// runs [runs[2 m], runs[2 m + 1]), m < count, the ones of an index above `after` within reach of
+// a centre: (x - cx)^2 + (y - cy)^2 + (z - cz)^2 < (reach + r)^2, each difference and sum taken
+// in that order. Writes their positions to hits (room for the runs' entries), run after run,
+// ascending in each, and returns how many.
 struct NearArgs {
   const double* x; const double* y; const double* z; const double* r;
   const std::int32_t* index;
@@ -212,7 +213,7 @@ struct NearArgs {
   std::int32_t after;
 };
 
-using NearKernel = std::size_t (*)(const NearArgs&, std::int32_t first, std::int32_t last,
+using NearKernel = std::size_t (*)(const NearArgs&, const std::int32_t* runs, std::size_t count,
                                    std::int32_t* hits);
 
 struct KernelSet {

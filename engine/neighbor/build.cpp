@@ -296,27 +296,18 @@ inline bool bonded(const State& s, std::size_t i, std::int32_t o) {
 // three cells of a row are adjacent in `members`, so each row is one run (less the cells that
 // hold only i's own group), which the kernel reads as columns: dx^2 + dy^2 + dz^2 < (Ri + skin +
 // Rj)^2 with d = xj - xi, the test of every search before, so the list is the same. Only its few
-// hits (bonded partners touch: they are among them) ask for j > i, the group and the partners.
-// `hits` has room for the longest row.
+// hits (bonded partners touch: they are among them) ask for the group and the partners. `hits`
+// has room for nine rows (CellGrid::longest_row).
 template <class Out>
 void neighbours_of(const State& s, const CellGrid& g, std::size_t i, std::int32_t* hits, Out&& out) {
   const ParticleStore& p = s.p;
   if (p.inert[i]) return;
   int ci, cj, ck;
   g.coords(p.x[i], p.y[i], p.z[i], ci, cj, ck);
-  const kernels::NearArgs args{g.mx.data(), g.my.data(), g.mz.data(), g.mr.data(), g.members.data(),
-                               p.x[i], p.y[i], p.z[i], p.radius[i] + s.skin, std::int32_t(i)};
   const std::int32_t gi = p.group[i];
   auto own = [&](std::size_t cell) { return gi >= 0 && g.group_of_cell[cell] == gi; };
-  auto run = [&](std::int32_t first, std::int32_t last) {
-    const std::size_t found = s.ctx.kernels->near(args, first, last, hits);
-    for (std::size_t h = 0; h < found; ++h) {
-      const std::int32_t o = g.members[std::size_t(hits[h])];
-      if (gi >= 0 && p.group[o] == gi) continue;
-      if (bonded(s, i, o)) continue;
-      out(o);
-    }
-  };
+  std::int32_t runs[2 * 9 * 2];  // at most two runs per row (its middle cell left out)
+  std::size_t count = 0;
   const int m0 = std::max(ci - 1, 0), m1 = std::min(ci + 1, g.nx - 1);
   for (int k = std::max(ck - 1, 0); k <= std::min(ck + 1, g.nz - 1); ++k)
     for (int j = std::max(cj - 1, 0); j <= std::min(cj + 1, g.ny - 1); ++j) {
@@ -328,10 +319,24 @@ void neighbours_of(const State& s, const CellGrid& g, std::size_t i, std::int32_
         }
         int e = m;
         while (e < m1 && !own(row + e + 1)) ++e;
-        run(g.start[row + m], g.start[row + e + 1]);
+        const std::int32_t first = g.start[row + m], last = g.start[row + e + 1];
+        if (first < last) {
+          runs[2 * count] = first;
+          runs[2 * count + 1] = last;
+          ++count;
+        }
         m = e + 1;
       }
     }
+  const kernels::NearArgs args{g.mx.data(), g.my.data(), g.mz.data(), g.mr.data(), g.members.data(),
+                               p.x[i], p.y[i], p.z[i], p.radius[i] + s.skin, std::int32_t(i)};
+  const std::size_t found = s.ctx.kernels->near(args, runs, count, hits);
+  for (std::size_t h = 0; h < found; ++h) {
+    const std::int32_t o = g.members[std::size_t(hits[h])];
+    if (gi >= 0 && p.group[o] == gi) continue;
+    if (bonded(s, i, o)) continue;
+    out(o);
+  }
 }
 
 void build_pairs(State& s, const CellGrid& g) {
@@ -346,7 +351,7 @@ void build_pairs(State& s, const CellGrid& g) {
   count.assign(n + 1, 0);
 #pragma omp parallel num_threads(thread_count(s))
   {
-    std::vector<std::int32_t> hits(std::size_t(g.longest_row));
+    std::vector<std::int32_t> hits(9 * std::size_t(g.longest_row));
 #pragma omp for schedule(dynamic, 1)
     for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
       std::vector<std::int32_t>& list = found[chunk];

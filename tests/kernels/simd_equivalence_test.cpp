@@ -798,9 +798,27 @@ TEST(KernelEquivalence, NeighbourRunKernelFindsWhatAPlainLoopFinds) {
   for (const auto* set : sets)
     for (std::int32_t first = 0; first <= n; ++first)
       for (std::int32_t last = first; last <= n; ++last) {
-        const std::size_t found = set->near(args, first, last, hits.data());
+        const std::int32_t run[2] = {first, last};
+        const std::size_t found = set->near(args, run, 1, hits.data());
         const std::vector<std::int32_t> want = plain(first, last);
         ASSERT_EQ(std::vector<std::int32_t>(hits.begin(), hits.begin() + std::ptrdiff_t(found)), want)
             << set->name << " [" << first << ", " << last << ")";
       }
+  // Several runs in one call, as the search passes a particle's rows: their hits run after run.
+  std::mt19937 pick(3);
+  for (const auto* set : sets)
+    for (int trial = 0; trial < 200; ++trial) {
+      std::vector<std::int32_t> runs, want;
+      const std::size_t count = pick() % 19;
+      for (std::size_t m = 0; m < count; ++m) {
+        const std::int32_t a = std::int32_t(pick() % (n + 1)), b = std::int32_t(pick() % (n + 1));
+        runs.insert(runs.end(), {std::min(a, b), std::max(a, b)});
+        const auto part = plain(std::min(a, b), std::max(a, b));
+        want.insert(want.end(), part.begin(), part.end());
+      }
+      std::vector<std::int32_t> all(count * n + 1);
+      const std::size_t found = set->near(args, runs.data(), count, all.data());
+      ASSERT_EQ(std::vector<std::int32_t>(all.begin(), all.begin() + std::ptrdiff_t(found)), want)
+          << set->name << ", trial " << trial;
+    }
 }
