@@ -10,7 +10,9 @@
 //   and re-sorts it. This keeps the pair list in the particles' memory order (good locality for
 //   the gathers) while carrying history as exactly as keying by stable ids would.
 // - The list is built particle by particle (each particle i lists its j > i in its 27 cells,
-//   sorted), counted first and filled second, so it is the same for any thread count.
+//   sorted), counted first and filled second, so it is the same for any thread count. The grid
+//   keeps a copy of the binned centres and radii in cell order, in which the three cells of a row
+//   are one contiguous run: a kernel tests a particle's nine rows a batch at a time.
 // - Pairs of two members of one rigid group are never listed.
 // - The reorder sorts the particles by cell along a Morton (Z-order) curve, or, in scenes of
 //   kRasterFrom particles and more, in the raster order of the cells (one axis fastest, then the
