@@ -349,8 +349,7 @@ void build_pairs(State& s, const CellGrid& g) {
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
   std::vector<std::vector<std::int32_t>>& found = s.cache.found_pairs;
   found.resize(chunks);
-  std::vector<std::int64_t>& count = s.cache.grid.pair_count;
-  count.assign(n + 1, 0);
+  std::vector<std::int64_t> count(n + 1, 0);
 #pragma omp parallel num_threads(thread_count(s))
   {
     std::vector<std::int32_t> hits(9 * std::size_t(g.longest_row));

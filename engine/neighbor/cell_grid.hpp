@@ -23,7 +23,6 @@ struct CellGrid {
   // group, which hold no pair for it: in a rigid joint that is most of the cells it looks at.
   std::vector<std::int32_t> group_of_cell;
   std::int32_t longest_row = 0;  // members in three adjacent cells of a row, at most
-  std::vector<std::int64_t> pair_count;  // the build's pairs per particle (a scratch column)
 
   int clampi(double v, int n) const {
     const double c = std::floor(v / cell);
