@@ -18,8 +18,10 @@ Vec3 closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, cons
 // (Mesh::bins), derived from its vertices and triangles.
 void bin_mesh(Mesh& mesh);
 // bodies/mesh.cpp: candidate triangles of `mesh` within `reach` of the point `q` (mesh
-// coordinates), sorted.
-void query_mesh(const Mesh& mesh, const Vec3& q, double reach, std::vector<std::int32_t>& out);
+// coordinates), each once, in the order of the bins. `seen` holds a byte per triangle of the
+// mesh, all 0, and is left so.
+void query_mesh(const Mesh& mesh, const Vec3& q, double reach, std::vector<std::int32_t>& out,
+                std::vector<std::uint8_t>& seen);
 // Whether triangle `tri` has vertex v.
 inline bool holds_vertex(const std::array<int, 3>& tri, int v) {
   return tri[0] == v || tri[1] == v || tri[2] == v;

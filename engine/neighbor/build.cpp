@@ -445,9 +445,12 @@ void build_wall_contacts(State& s) {
   for (Wall& wall : walls)
     wall.candidates_within_half_skin =
         wall.kind == Wall::Kind::mesh && !wall.removed && wall.velocity == Vec3{0, 0, 0};
+  std::size_t most_triangles = 0;
+  for (const Mesh& mesh : s.walls.meshes) most_triangles = std::max(most_triangles, mesh.triangles.size());
 #pragma omp parallel num_threads(thread_count(s))
   {
     std::vector<std::int32_t> tris;
+    std::vector<std::uint8_t> seen(most_triangles, 0);
 #pragma omp for schedule(dynamic, 1)
     for (std::size_t chunk = 0; chunk < chunks; ++chunk)
       for (std::size_t i = chunk * kChunk; i < std::min(n, (chunk + 1) * kChunk); ++i) {
@@ -469,7 +472,8 @@ void build_wall_contacts(State& s) {
             const Mesh& mesh = s.walls.meshes[wall.mesh];
             const Vec3 q = c - wall.displacement;
             const double r = wall.candidates_within_half_skin && p.group[i] < 0 ? near_reach : reach;
-            query_mesh(mesh, q, r, tris);
+            query_mesh(mesh, q, r, tris, seen);
+            const std::size_t first = cand[chunk].size();
             for (std::int32_t t : tris) {
               const auto& tri = mesh.triangles[t];
               int feature;
@@ -479,6 +483,9 @@ void build_wall_contacts(State& s) {
               const Vec3 d = q - cp;
               if (dot(d, d) < r * r) cand[chunk].push_back({std::int32_t(i), std::int32_t(w), t, norm(d)});
             }
+            // The few within reach in facet order, the list's order (by particle, wall, facet).
+            std::sort(cand[chunk].begin() + std::ptrdiff_t(first), cand[chunk].end(),
+                      [](const Candidate& u, const Candidate& v) { return u.facet < v.facet; });
           }
         }
       }
