@@ -3,8 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
+#include <utility>
+#include <vector>
 
 #include "asperity/world.hpp"
+#include "bodies/mesh.hpp"
 #include "state.hpp"
 
 using namespace asperity;
@@ -287,4 +291,53 @@ TEST(Walls, FreeSphereSlidingOverAStillMeshKeepsItsContact) {
   EXPECT_GT(w.stats().rebuilds, rebuilds + 5);
   EXPECT_NEAR(low, R - F / kn, 1e-9);
   EXPECT_NEAR(high, R - F / kn, 1e-9);
+}
+
+// The wall contacts a build lists on a still mesh are the triangles a check of every triangle
+// finds: for each free particle, every triangle whose closest point lies within R + skin/2 (the
+// still mesh's reach, Wall::candidates_within_half_skin) by the same computation, in facet order.
+// A bumpy mesh, its triangles in many bins each, under particles of radii 0.2 to 0.8 mm.
+TEST(Walls, AStillMeshListsTheTrianglesACheckOfEveryTriangleFinds) {
+  WorldSettings ws;
+  ws.dt = 1e-6;
+  ws.skin = 2e-4;
+  World w(ws);
+  const int cells = 40;
+  const double h = 3e-4;
+  std::vector<Vec3> v;
+  std::vector<std::array<int, 3>> t;
+  flat_mesh(cells, h, v, t);
+  for (auto& p : v) p.z = 2e-4 * std::sin(p.x / 7e-4) * std::cos(p.y / 5e-4);
+  w.add_mesh(v, t, ContactMaterial{});
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<double> xyz, radii;
+  for (int i = 0; i < 600; ++i) {
+    xyz.insert(xyz.end(), {cells * h * u(rng), cells * h * u(rng), -1e-3 + 2.5e-3 * u(rng)});
+    radii.push_back(2e-4 + 6e-4 * u(rng));
+  }
+  w.add_particles(xyz, radii, 2500.0);
+  w.rebuild_neighbors();
+  const auto& s = w.state();
+  const auto& p = s.p;
+  const auto& mesh = s.walls.meshes[0];
+  std::vector<std::pair<std::int64_t, std::int32_t>> want, got;
+  for (std::size_t i = 0; i < p.n; ++i) {
+    const double r = (p.radius[i] + 0.5 * s.skin) * (1 + 1e-9);
+    for (std::size_t k = 0; k < mesh.triangles.size(); ++k) {
+      const auto& tri = mesh.triangles[k];
+      int feature;
+      const Vec3 q{p.x[i], p.y[i], p.z[i]};
+      const Vec3 d = q - detail::closest_point_on_triangle(q, mesh.vertices[tri[0]], mesh.vertices[tri[1]],
+                                                           mesh.vertices[tri[2]], feature);
+      if (dot(d, d) < r * r) want.emplace_back(std::int64_t(i), std::int32_t(k));
+    }
+  }
+  const auto& wc = s.walls.contacts;
+  for (std::size_t k = 0; k < wc.n; ++k) {
+    EXPECT_EQ(wc.wall[k], 0);
+    got.emplace_back(wc.particle[k], wc.facet[k]);
+  }
+  EXPECT_GT(want.size(), 600u);  // several triangles a particle
+  EXPECT_EQ(got, want);
 }
