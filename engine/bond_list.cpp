@@ -225,6 +225,9 @@ std::size_t install_bonds(State& s, const BondMaterial& material, double toleran
   ensure_skin(s);
   if (s.skin < 2 * tolerance) s.skin = 2 * tolerance;
   build_neighbors(s);
+  // The bonds' store is made beside the pair list, not beside its spares too (a genesis's, kept
+  // at its widest list: its peak memory); the relaxation's builds make them again at their size.
+  release_spares(s);
   // The chosen particles by index after the build: it may have reordered the store (marked
   // before it, other particles were bonded: across the mould of the 4 cm joint).
   std::vector<std::uint8_t> chosen(p.n, ids.empty() ? 1 : 0);

@@ -80,11 +80,15 @@ struct Caches {
   bool pair_records_sparse = false;
   ServoContacts servo;  // the contacts between bodies, for the servo (store/groups.hpp)
   // Stores filled and swapped in place of allocating: the pairs a break step's broken bonds free
-  // (process_breaks), and the pair list's other half, which a neighbour build or the merge of the
-  // freed pairs writes into (build_pairs, insert_pairs; kept between builds only where bonds can
-  // break).
+  // (process_breaks), and the other halves of the pair list and the wall contact list, which a
+  // neighbour build, a reorder or the merge of the freed pairs writes into (build_pairs,
+  // build_wall_contacts, reorder, insert_pairs; kept between builds only where builds or merges
+  // come often: neighbor/build.cpp, keep_spares).
   PairStore freed_pairs, spare_pairs;
+  WallContacts spare_wall_contacts;
   std::vector<std::vector<std::int32_t>> found_pairs;  // a neighbour build's, per chunk of particles
+  std::vector<std::vector<WallCandidate>> found_wall_contacts;  // the same for the walls
+  std::uint64_t last_build_step = 0;  // State::step at the last neighbour build
   CellGrid grid;  // the last neighbour build's cells (neighbor/cell_grid.hpp)
   // Idle group members (see Group::busy), per particle index; valid while idle_valid (the split
   // is redone at every neighbour build and after the API changes motions or applied forces).

@@ -1,5 +1,7 @@
 // Small scenes and helpers shared by the engine's tests.
 #pragma once
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <random>
@@ -61,6 +63,24 @@ inline World random_box(int n, WorldSettings ws = {}, unsigned seed = 1, double 
   w.add_plane({0, L, 0}, {0, -1, 0});
   w.add_plane({0, 0, lift + 2 * L + double(n / (side * side)) * cell}, {0, 0, -1});
   return w;
+}
+
+// A still, bumpy mesh over random_box's 12 mm floor (a mould: heights 0 to 1 mm, cells x cells
+// squares of two triangles each); its wall index.
+inline int add_bumpy_mould(World& w, int cells) {
+  const double h = 12e-3 / cells;
+  std::vector<Vec3> v;
+  std::vector<std::array<int, 3>> t;
+  for (int j = 0; j <= cells; ++j)
+    for (int i = 0; i <= cells; ++i)
+      v.push_back({i * h, j * h, 0.5e-3 * (1 + std::sin(0.9 * i) * std::cos(0.7 * j))});
+  for (int j = 0; j < cells; ++j)
+    for (int i = 0; i < cells; ++i) {
+      const int a = j * (cells + 1) + i;
+      t.push_back({a, a + 1, a + cells + 2});
+      t.push_back({a, a + cells + 2, a + cells + 1});
+    }
+  return w.add_mesh(v, t);
 }
 
 // n x n x `layers` spheres of diameter d on a grid of pitch 0.99 d (neighbours overlap by 1 %),

@@ -187,6 +187,16 @@ void renumber_bonds(BondStore& bq, const std::vector<std::int64_t>& new_index) {
 
 // Renumber particles along the Morton curve of their cells, or in their raster order in large
 // scenes (design notes), stable within a cell, and every index that refers to them.
+// A spare that a busier phase left more than twice as large as the list now written into it
+// (a genesis's pairs at its widest skin, its mould's candidates) is released first, so that the
+// next phases do not carry that phase's memory.
+void release_if_oversized(PairStore& q, std::size_t pairs) {
+  if (q.a.capacity() > 2 * round_up(pairs, kMaxLanes)) q = PairStore();
+}
+void release_if_oversized(WallContacts& w, std::size_t contacts) {
+  if (w.particle.capacity() > 2 * contacts) w = WallContacts();
+}
+
 void reorder(State& s, const CellGrid& g) {
   ParticleStore& p = s.p;
   const std::size_t n = p.n;
@@ -235,14 +245,15 @@ void reorder(State& s, const CellGrid& g) {
   std::sort(perm.begin(), perm.end(), [&](std::size_t u, std::size_t v) {
     return q.a[u] != q.a[v] ? q.a[u] < q.a[v] : q.b[u] < q.b[v];
   });
-  PairStore sorted;
+  PairStore& sorted = s.cache.spare_pairs;
+  release_if_oversized(sorted, q.n);
   sorted.resize(q.n);
   for (std::size_t k = 0; k < q.n; ++k) {
     const std::size_t o = perm[k];
     sorted.a[k] = q.a[o]; sorted.b[k] = q.b[o];
     sorted.copy_history(q, o, k);
   }
-  q = std::move(sorted);
+  std::swap(q, sorted);
 
   // Wall contacts: renumber and re-sort by (particle, wall, facet).
   WallContacts& w = s.walls.contacts;
@@ -253,15 +264,17 @@ void reorder(State& s, const CellGrid& g) {
     return std::tie(w.particle[u], w.wall[u], w.facet[u]) <
            std::tie(w.particle[v], w.wall[v], w.facet[v]);
   });
-  WallContacts ws;
+  WallContacts& ws = s.cache.spare_wall_contacts;
+  release_if_oversized(ws, w.n);
   ws.resize(w.n);
+  const bool distances = w.distance.size() == w.n;
   for (std::size_t k = 0; k < w.n; ++k) {
     const std::size_t o = wp[k];
     ws.particle[k] = w.particle[o]; ws.wall[k] = w.wall[o]; ws.facet[k] = w.facet[o];
     WallContacts::history_columns([&](const ColumnInfo&, auto& to, const auto& from) { to[k] = from[o]; }, ws, w);
-    if (w.distance.size() == w.n) ws.distance[k] = w.distance[o];
+    ws.distance[k] = distances ? w.distance[o] : 0.0;  // 0: unknown, never skips (WallContacts)
   }
-  w = std::move(ws);
+  std::swap(w, ws);
 
   // Bonds, active and frozen: the same renumbering; the history flips with the roles.
   renumber_bonds(s.bonds, new_index);
@@ -371,6 +384,7 @@ void build_pairs(State& s, const CellGrid& g) {
   // Written into the spare store (its pages mapped and zeroed once: a fracture run rebuilds every
   // hundred steps or so, and fresh pages for the list cost as much as its search) and swapped in.
   PairStore& fresh = s.cache.spare_pairs;
+  release_if_oversized(fresh, total);
   fresh.resize(total);
   // Carry history: both lists sorted by (a, b), each chunk's pairs merged with the old list from
   // where its first particle's pairs begin there.
@@ -419,11 +433,7 @@ void build_pairs(State& s, const CellGrid& g) {
     ih.resize(0);
   }
   fresh.fill_padding(p.null_a(), p.null_b());
-  std::swap(s.pairs, fresh);
-  // The previous list is kept as the next spare only where bonds can break (a fracture run
-  // rebuilds and merges freed pairs every few dozen steps); elsewhere it is released: a second
-  // list for the whole run would be a second pair store of resident memory.
-  if (!(s.bonds.n > 0 && s.bonds.material.breakable)) fresh = PairStore();
+  std::swap(s.pairs, fresh);  // the previous list is the spare now (build_neighbors, keep_spares)
   build_incidence(n, s.pairs.a.data(), s.pairs.b.data(), total, s.incidence);
 }
 
@@ -431,17 +441,17 @@ void build_wall_contacts(State& s) {
   const ParticleStore& p = s.p;
   const std::size_t n = p.n;
   auto& walls = s.walls.walls;
-  struct Candidate {
-    std::int32_t particle, wall, facet;
-    double distance;  // centre to the triangle (mesh); 0 for a plane
-  };
+  using Candidate = WallCandidate;
   // Per chunk of kChunk particles, in particle order (the unit the threads share out): a few
   // hundred lists where one per particle would be a hundred thousand small ones, allocated again
   // at every build, whose growing sizes fragment the heap (a genesis rebuilds hundreds of times
-  // while its radii grow, and its resident memory grew with them).
+  // while its radii grow, and its resident memory grew with them). Kept between builds with the
+  // spares (keep_spares).
   constexpr std::size_t kChunk = 256;
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
-  std::vector<std::vector<Candidate>> cand(chunks);
+  std::vector<std::vector<Candidate>>& cand = s.cache.found_wall_contacts;
+  cand.resize(chunks);
+  for (auto& list : cand) list.clear();
   for (Wall& wall : walls)
     wall.candidates_within_half_skin =
         wall.kind == Wall::Kind::mesh && !wall.removed && wall.velocity == Vec3{0, 0, 0};
@@ -490,9 +500,10 @@ void build_wall_contacts(State& s) {
         }
       }
   }
-  WallContacts fresh;
+  WallContacts& fresh = s.cache.spare_wall_contacts;
   std::size_t total = 0;
   for (auto& c : cand) total += c.size();
+  release_if_oversized(fresh, total);
   fresh.resize(total);
   fresh.start.assign(n + 1, 0);
   std::size_t k = 0;
@@ -518,7 +529,20 @@ void build_wall_contacts(State& s) {
       to[k] = known ? from[o] : c.pad;
     }, fresh, old);
   }
-  s.walls.contacts = std::move(fresh);
+  std::swap(s.walls.contacts, fresh);  // the previous list is the spare now
+}
+
+// Whether a build keeps the lists it replaced (the pair and wall contact lists, the chunks' found
+// lists) as spares for the next build, reorder or merge to write into, or releases them. A list's
+// fresh pages (mapped, zeroed by the system, then value-initialised) cost about what its search
+// does: that counts where builds come every few dozen or hundred steps (a genesis, a fracture
+// run's debris) and is lost in the steps where they come every few thousand (a closure, an
+// elastic shear), where a spare would be a second list of resident memory for nothing. Where
+// bonds can break, break steps merge freed pairs through the spare pair store (insert_pairs).
+constexpr std::uint64_t kSpareBuildGap = 1000;  // steps
+
+bool keep_spares(const State& s) {
+  return (s.bonds.n > 0 && s.bonds.material.breakable) || s.step - s.cache.last_build_step < kSpareBuildGap;
 }
 
 }  // namespace
@@ -533,6 +557,7 @@ void ensure_skin(State& s) {
 
 void build_neighbors(State& s) {
   ParticleStore& p = s.p;
+  const bool keep = keep_spares(s);
   compact_bonds(s);  // the bonds that broke since the last build leave the list (before a reorder)
   sync_lazy(s);  // idle group members are searched: bring them to where they are
   ensure_skin(s);
@@ -554,11 +579,20 @@ void build_neighbors(State& s) {
     p.z0[i] = p.z[i];
   }
   for (auto& w : s.walls.walls) w.displacement_at_build = w.displacement;
+  if (!keep) release_spares(s);
+  s.cache.last_build_step = s.step;
   ++s.rebuilds;
   ++s.rebuilds_since_reorder;
   s.need_rebuild = false;
   s.cache.idle_pairs_only = false;  // the groups' members may have moved between bodies' reach
   split_idle(s);
+}
+
+void release_spares(State& s) {
+  s.cache.spare_pairs = PairStore();
+  s.cache.spare_wall_contacts = WallContacts();
+  s.cache.found_pairs = {};
+  s.cache.found_wall_contacts = {};
 }
 
 void build_incidence(std::size_t particles, const std::int64_t* a, const std::int64_t* b,

@@ -10,6 +10,8 @@ namespace asperity::detail {
 // builds), the history carried over, the time step re-estimated.
 void build_neighbors(State& s);
 void ensure_skin(State& s);  // derive the automatic skin if unset
+// The lists a build keeps to write the next one into (Caches::spare_pairs ...) released.
+void release_spares(State& s);
 // Pair k of q (a and b set) as the search starts a new one: the current direction as its
 // previous normal, no shear or normal force, no rest overlap. Returns the centres' distance.
 double start_pair(PairStore& q, std::size_t k, const ParticleStore& p);

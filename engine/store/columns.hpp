@@ -51,13 +51,20 @@ void remove_slots(V& col, const std::vector<std::size_t>& rows, std::size_t n) {
   }
 }
 
-// New slot i holds old slot order[i]; the slots past `order` keep theirs.
+// New slot i holds old slot order[i]; the slots past `order` keep theirs. Written into `out`,
+// which then holds the column's old memory: columns of one size permuted through one `out` take
+// turns with its pages instead of each allocating fresh ones.
 template <class V>
-void permute_column(V& col, const std::vector<std::int32_t>& order) {
-  V out(col.size());
+void permute_column(V& col, const std::vector<std::int32_t>& order, V& out) {
+  out.resize(col.size());
   for (std::size_t i = 0; i < order.size(); ++i) out[i] = col[order[i]];
   for (std::size_t i = order.size(); i < col.size(); ++i) out[i] = col[i];
   col.swap(out);
+}
+template <class V>
+void permute_column(V& col, const std::vector<std::int32_t>& order) {
+  V out;
+  permute_column(col, order, out);
 }
 
 }  // namespace asperity::detail

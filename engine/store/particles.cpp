@@ -1,6 +1,7 @@
 #include "store/particles.hpp"
 
 #include <algorithm>
+#include <type_traits>
 
 namespace asperity::detail {
 
@@ -19,8 +20,12 @@ void ParticleStore::resize(std::size_t new_n) {
 }
 
 void ParticleStore::permute(const std::vector<std::int32_t>& order) {
+  // The double columns, most of the store, all `capacity` long, through one scratch column.
+  AVec<double> scratch;
   slot_columns([&](const ColumnInfo& c, auto& col) {
-    if (!c.optional || has_applied) permute_column(col, order);
+    if (c.optional && !has_applied) return;
+    if constexpr (std::is_same_v<std::decay_t<decltype(col)>, AVec<double>>) permute_column(col, order, scratch);
+    else permute_column(col, order);
   }, *this);
   particle_columns([&](const ColumnInfo&, auto& col) { permute_column(col, order); }, *this);
   for (std::size_t i = 0; i < n; ++i) index_of_id[id[i]] = static_cast<std::int64_t>(i);

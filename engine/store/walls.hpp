@@ -66,6 +66,12 @@ struct Wall {
   bool candidates_within_half_skin = false;
 };
 
+// A wall contact a neighbour build found, before the list is made of them (neighbor/build.cpp).
+struct WallCandidate {
+  std::int32_t particle, wall, facet;
+  double distance;  // centre to the triangle (mesh); 0 for a plane
+};
+
 // Ball-wall contacts within the skin, sorted by (particle, wall, facet). The particle plays the
 // role of b in the contact law: the normal points from the wall to the centre.
 struct WallContacts {

@@ -55,20 +55,7 @@ TEST(Determinism, SpheresOnAStillMouldAreTheSameOnOneAndTwoThreads) {
     WorldSettings ws;
     ws.threads = threads;
     World w = test::random_box(1200, ws, 3, 1.5e-3);
-    const int cells = 48;
-    const double h = 12e-3 / cells;
-    std::vector<Vec3> v;
-    std::vector<std::array<int, 3>> t;
-    for (int j = 0; j <= cells; ++j)
-      for (int i = 0; i <= cells; ++i)
-        v.push_back({i * h, j * h, 0.5e-3 * (1 + std::sin(0.9 * i) * std::cos(0.7 * j))});
-    for (int j = 0; j < cells; ++j)
-      for (int i = 0; i < cells; ++i) {
-        const int a = j * (cells + 1) + i;
-        t.push_back({a, a + 1, a + cells + 2});
-        t.push_back({a, a + cells + 2, a + cells + 1});
-      }
-    const int mould = w.add_mesh(v, t);
+    const int mould = test::add_bumpy_mould(w, 48);
     w.cycle(3000);
     EXPECT_TRUE(w.state().walls.walls[mould].candidates_within_half_skin);
     EXPECT_LT(w.wall_force(mould).z, 0) << "the spheres press on the mould";
