@@ -185,8 +185,6 @@ void renumber_bonds(BondStore& bq, const std::vector<std::int64_t>& new_index) {
   bq = std::move(bs);
 }
 
-// Renumber particles along the Morton curve of their cells, or in their raster order in large
-// scenes (design notes), stable within a cell, and every index that refers to them.
 // A spare that a busier phase left more than twice as large as the list now written into it
 // (a genesis's pairs at its widest skin, its mould's candidates) is released first, so that the
 // next phases do not carry that phase's memory.
@@ -197,6 +195,8 @@ void release_if_oversized(WallContacts& w, std::size_t contacts) {
   if (w.particle.capacity() > 2 * contacts) w = WallContacts();
 }
 
+// Renumber particles along the Morton curve of their cells, or in their raster order in large
+// scenes (design notes), stable within a cell, and every index that refers to them.
 void reorder(State& s, const CellGrid& g) {
   ParticleStore& p = s.p;
   const std::size_t n = p.n;
@@ -441,7 +441,6 @@ void build_wall_contacts(State& s) {
   const ParticleStore& p = s.p;
   const std::size_t n = p.n;
   auto& walls = s.walls.walls;
-  using Candidate = WallCandidate;
   // Per chunk of kChunk particles, in particle order (the unit the threads share out): a few
   // hundred lists where one per particle would be a hundred thousand small ones, allocated again
   // at every build, whose growing sizes fragment the heap (a genesis rebuilds hundreds of times
@@ -449,7 +448,7 @@ void build_wall_contacts(State& s) {
   // spares (keep_spares).
   constexpr std::size_t kChunk = 256;
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
-  std::vector<std::vector<Candidate>>& cand = s.cache.found_wall_contacts;
+  std::vector<std::vector<WallCandidate>>& cand = s.cache.found_wall_contacts;
   cand.resize(chunks);
   for (auto& list : cand) list.clear();
   for (Wall& wall : walls)
@@ -495,7 +494,7 @@ void build_wall_contacts(State& s) {
             }
             // The few within reach in facet order, the list's order (by particle, wall, facet).
             std::sort(cand[chunk].begin() + std::ptrdiff_t(first), cand[chunk].end(),
-                      [](const Candidate& u, const Candidate& v) { return u.facet < v.facet; });
+                      [](const WallCandidate& u, const WallCandidate& v) { return u.facet < v.facet; });
           }
         }
       }
@@ -508,7 +507,7 @@ void build_wall_contacts(State& s) {
   fresh.start.assign(n + 1, 0);
   std::size_t k = 0;
   for (const auto& list : cand)
-    for (const Candidate& c : list) {
+    for (const WallCandidate& c : list) {
       fresh.particle[k] = c.particle;
       fresh.wall[k] = c.wall;
       fresh.facet[k] = c.facet;
