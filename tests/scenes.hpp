@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <random>
 #include <string>
@@ -21,6 +22,11 @@ inline std::string error_of(auto&& call) {
     return e.what();
   }
   return "(no error)";
+}
+
+// The same length and the same bits (a NaN equals itself, +0 differs from -0).
+inline bool same_bits(const std::vector<double>& u, const std::vector<double>& v) {
+  return u.size() == v.size() && std::memcmp(u.data(), v.data(), u.size() * sizeof(double)) == 0;
 }
 
 // Particles (a, b) of pair k of `pairs` in the random inputs of the SIMD-vs-scalar kernel tests.

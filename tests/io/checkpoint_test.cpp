@@ -14,10 +14,6 @@ namespace {
 std::string temp_file(const char* name) {
   return (std::filesystem::temp_directory_path() / name).string();
 }
-
-bool same(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
-}
 }  // namespace
 
 namespace {
@@ -74,11 +70,11 @@ void restart_continues_bit_for_bit(bool stress_free_bonds) {
   World q = World::load(path, 1, "scalar");
   r.cycle(700);
   q.cycle(700);
-  EXPECT_TRUE(same(w.positions(), r.positions()));
-  EXPECT_TRUE(same(w.velocities(), r.velocities()));
-  EXPECT_TRUE(same(w.forces(), r.forces()));
-  EXPECT_TRUE(same(w.positions(), q.positions()));
-  EXPECT_TRUE(same(w.forces(), q.forces()));
+  EXPECT_TRUE(test::same_bits(w.positions(), r.positions()));
+  EXPECT_TRUE(test::same_bits(w.velocities(), r.velocities()));
+  EXPECT_TRUE(test::same_bits(w.forces(), r.forces()));
+  EXPECT_TRUE(test::same_bits(w.positions(), q.positions()));
+  EXPECT_TRUE(test::same_bits(w.forces(), q.forces()));
   EXPECT_EQ(w.bond_count(), r.bond_count());
   EXPECT_EQ(w.break_events().size(), r.break_events().size());
   EXPECT_GT(w.bond_count(), 0u) << "the scene must hold bonds";
@@ -156,10 +152,10 @@ TEST(Checkpoint, SavingChangesNothingOfTheRun) {
   for (World* x : {&w, &u, &r}) x->cycle(2000);
   EXPECT_EQ(r.group_force(0), u.group_force(0));
   EXPECT_GT(w.state().rebuilds, 1u);
-  EXPECT_TRUE(same(w.positions(), u.positions())) << "saving changed the run";
-  EXPECT_TRUE(same(w.velocities(), u.velocities()));
-  EXPECT_TRUE(same(r.positions(), u.positions())) << "the loaded world parts from the run it was saved from";
-  EXPECT_TRUE(same(r.forces(), u.forces()));
+  EXPECT_TRUE(test::same_bits(w.positions(), u.positions())) << "saving changed the run";
+  EXPECT_TRUE(test::same_bits(w.velocities(), u.velocities()));
+  EXPECT_TRUE(test::same_bits(r.positions(), u.positions())) << "the loaded world parts from the run it was saved from";
+  EXPECT_TRUE(test::same_bits(r.forces(), u.forces()));
   EXPECT_EQ(r.state().rebuilds, u.state().rebuilds);
   EXPECT_EQ(r.energies().boundary_work, u.energies().boundary_work);
   std::filesystem::remove(path);

@@ -13,10 +13,6 @@
 using namespace asperity;
 
 namespace {
-bool same(const std::vector<double>& u, const std::vector<double>& v) {
-  return u.size() == v.size() && std::memcmp(u.data(), v.data(), u.size() * sizeof(double)) == 0;
-}
-
 // Spheres falling into a box on a still, bumpy mould (planes and a mesh: both wall lists), their
 // radii grown then shrunk as a genesis does (the lists grow past their spares' sizes, then fall
 // below half of them), reordered every other build, with breakable bonds installed half-way (break
@@ -71,7 +67,7 @@ TEST(Spares, ListsWrittenIntoTheLastListsStoresGiveTheRunFreshStoresGive) {
   EXPECT_GT(reused, 30u) << "the builds must write into the last lists' stores";
   EXPECT_EQ(reused_fresh, 0u);
   ASSERT_EQ(kept.size(), fresh.size());
-  for (std::size_t k = 0; k < kept.size(); ++k) EXPECT_TRUE(same(kept[k], fresh[k])) << "record " << k;
+  for (std::size_t k = 0; k < kept.size(); ++k) EXPECT_TRUE(test::same_bits(kept[k], fresh[k])) << "record " << k;
 }
 
 // Where builds come seldom, a build releases the spares (a second list of resident memory for

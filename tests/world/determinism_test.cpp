@@ -24,12 +24,6 @@
 
 using namespace asperity;
 
-namespace {
-// The same length and the same bits (a NaN equals itself, +0 differs from -0).
-bool same(const std::vector<double>& u, const std::vector<double>& v) {
-  return u.size() == v.size() && std::memcmp(u.data(), v.data(), u.size() * sizeof(double)) == 0;
-}
-}  // namespace
 
 TEST(Determinism, FullStateBitwiseIdenticalWithOneAndTwoThreads) {
   WorldSettings one, two;
@@ -39,9 +33,9 @@ TEST(Determinism, FullStateBitwiseIdenticalWithOneAndTwoThreads) {
   a.cycle(1500);
   b.cycle(1500);
   ASSERT_GT(a.contact_count(), 500u) << "the scene must be busy";
-  EXPECT_TRUE(same(a.positions(), b.positions()));
-  EXPECT_TRUE(same(a.velocities(), b.velocities()));
-  EXPECT_TRUE(same(a.forces(), b.forces()));
+  EXPECT_TRUE(test::same_bits(a.positions(), b.positions()));
+  EXPECT_TRUE(test::same_bits(a.velocities(), b.velocities()));
+  EXPECT_TRUE(test::same_bits(a.forces(), b.forces()));
   const Energies ea = a.energies(), eb = b.energies();
   EXPECT_EQ(ea.friction, eb.friction);
   EXPECT_EQ(ea.damping, eb.damping);
@@ -62,9 +56,9 @@ TEST(Determinism, SpheresOnAStillMouldAreTheSameOnOneAndTwoThreads) {
     return w;
   };
   World a = run(1), b = run(2);
-  EXPECT_TRUE(same(a.positions(), b.positions()));
-  EXPECT_TRUE(same(a.velocities(), b.velocities()));
-  EXPECT_TRUE(same(a.forces(), b.forces()));
+  EXPECT_TRUE(test::same_bits(a.positions(), b.positions()));
+  EXPECT_TRUE(test::same_bits(a.velocities(), b.velocities()));
+  EXPECT_TRUE(test::same_bits(a.forces(), b.forces()));
   EXPECT_EQ(a.energies().friction, b.energies().friction);
   const int mould = 6;  // after the box's six planes
   EXPECT_EQ(a.wall_force(mould).z, b.wall_force(mould).z);
@@ -102,9 +96,9 @@ TEST(Determinism, PlatensMovedInTheParallelRegionAreTheSameOnOneAndTwoThreads) {
   ASSERT_GE(2u * n * n, 512u);
   ASSERT_GT(one.group_position(top1).x - start.x, 0.0);
   ASSERT_GT(one.group_force(top1).z, 0.0);
-  EXPECT_TRUE(same(one.positions(), two.positions()));
-  EXPECT_TRUE(same(one.velocities(), two.velocities()));
-  EXPECT_TRUE(same(one.forces(), two.forces()));
+  EXPECT_TRUE(test::same_bits(one.positions(), two.positions()));
+  EXPECT_TRUE(test::same_bits(one.velocities(), two.velocities()));
+  EXPECT_TRUE(test::same_bits(one.forces(), two.forces()));
   for (int g : {0, top1}) {
     EXPECT_EQ(one.group_force(g).x, two.group_force(g).x) << g;
     EXPECT_EQ(one.group_force(g).z, two.group_force(g).z) << g;
@@ -233,10 +227,10 @@ std::vector<double> angular_velocities(const World& w) {
 }
 
 void expect_same_run(const World& a, const World& b) {
-  EXPECT_TRUE(same(a.positions(), b.positions()));
-  EXPECT_TRUE(same(a.velocities(), b.velocities()));
-  EXPECT_TRUE(same(angular_velocities(a), angular_velocities(b)));
-  EXPECT_TRUE(same(a.forces(), b.forces()));
+  EXPECT_TRUE(test::same_bits(a.positions(), b.positions()));
+  EXPECT_TRUE(test::same_bits(a.velocities(), b.velocities()));
+  EXPECT_TRUE(test::same_bits(angular_velocities(a), angular_velocities(b)));
+  EXPECT_TRUE(test::same_bits(a.forces(), b.forces()));
 }
 
 }  // namespace
