@@ -200,9 +200,13 @@ function M.restore(run, state)
           run.checkpoint.resumes)
 end
 
--- The run ended: its saved state goes.
+-- The run ended: its saved state goes. The states' markers (state.lua, what find looks for) go
+-- first, each in one unlink, and the folders after them: a folder removal cut short by a kill
+-- could otherwise leave a state.lua whose world.h5 was already removed, which the next run would
+-- find and fail to load.
 function M.clear(run)
   local P = run.P
+  for _, path in ipairs{dir(P), dir(P) .. ".old"} do os.remove(path .. "/state.lua") end
   for _, path in ipairs{dir(P), dir(P) .. ".new", dir(P) .. ".old"} do remove_state(path) end
 end
 
