@@ -162,8 +162,11 @@ void process_breaks(State& s) {
       const double fs = std::sqrt(q.fsx[k] * q.fsx[k] + q.fsy[k] * q.fsy[k] + q.fsz[k] * q.fsz[k]);
       ev.sigma = -q.fn[k] / A;
       ev.tau = fs / A;
-      ev.mode = -q.fn[k] >= bm.contact_strength * bm.tensile_strength * A ? BreakEvent::Mode::tension
-                                                                          : BreakEvent::Mode::shear;  // as the kernel
+      double fcn, fcs;  // the kernel's verdict: tension where the tension reached Fcn, else shear
+      kernels::contact_bond_strengths(bm.tensile_strength, rb, bm.contact_strength, bm.contact_shear_strength,
+                                      bm.contact_bond_friction, q.fn[k], fcn, fcs);
+      ev.mode = kernels::contact_bond_failure(q.fn[k], q.fsx[k], q.fsy[k], q.fsz[k], fcn, fcs) == 1.0
+                    ? BreakEvent::Mode::tension : BreakEvent::Mode::shear;
       ev.kind = BreakEvent::Kind::contact_bond;
       book(kernels::spring_energy(q, k, m) - spring_kept);
     }

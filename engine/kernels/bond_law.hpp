@@ -39,6 +39,19 @@ inline T contact_bond_failure(const T& fn, const T& fsx, const T& fsy, const T& 
   return select(tension, T(1.0), select(shear, T(2.0), T(0.0)));
 }
 
+// The contact bond's strengths (model.md 5) for a beam of radius rb: Fcn = c st A in tension,
+// Fcs = cs st A in shear (cs = 0: c), plus mu_b Fn under compression where mu_b > 0 (PFC's
+// Mohr-Coulomb contact bond). The bond kernel and the break events' modes (bond_list.cpp) both
+// take them from here.
+template <class T>
+inline void contact_bond_strengths(const T& st, const T& rb, double c, double cs, double mu_b, const T& fn,
+                                   T& fcn, T& fcs) {
+  const T st_area = st * (kPi * rb * rb);  // st A
+  fcn = T(c) * st_area;
+  fcs = T(cs > 0 ? cs : c) * st_area;
+  if (mu_b > 0) fcs = fcs + T(mu_b) * select(fn > T(0.0), fn, T(0.0));
+}
+
 // Criterion value ((sigma - h) / a)^2 + (tau / b)^2 for strength st (>= 1: the bond fails).
 template <class T>
 inline T elliptic_criterion(const T& sigma, const T& tau, const T& st) {

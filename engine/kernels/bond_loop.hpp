@@ -83,10 +83,10 @@ BondSums bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) 
       const auto beam_fails = beam_on & (crit >= T(1.0));
       T brk = select(beam_fails, T(with_beam ? kBothHold : kBeamHolds), T(0.0));
       if (contact_breaks) {
-        const T st_area = p.strength * (kPi * rsafe * rsafe);  // st A
-        T fcs = T(shear_factor) * st_area;
-        if (k.contact_bond_friction > 0) fcs = fcs + T(k.contact_bond_friction) * select(s.fn > T(0.0), s.fn, T(0.0));
-        const T cf = contact_bond_failure(s.fn, s.fsx, s.fsy, s.fsz, T(k.contact_strength) * st_area, fcs);
+        T fcn, fcs;
+        contact_bond_strengths(p.strength, rsafe, k.contact_strength, k.contact_shear_strength,
+                               k.contact_bond_friction, s.fn, fcn, fcs);
+        const T cf = contact_bond_failure(s.fn, s.fsx, s.fsy, s.fsz, fcn, fcs);
         brk = brk + select(contact_on & (cf != T(0.0)), T(kContactBondHolds), T(0.0));
       }
       count = count + select(brk != T(0.0), T(1.0), T(0.0));
