@@ -39,6 +39,9 @@ inline T contact_bond_failure(const T& fn, const T& fsx, const T& fsy, const T& 
   return select(tension, T(1.0), select(shear, T(2.0), T(0.0)));
 }
 
+// The contact bond's shear strength factor: cs, or c where cs is 0 (BondMaterial).
+inline double contact_shear_factor(double c, double cs) { return cs > 0 ? cs : c; }
+
 // The contact bond's strengths (model.md 5) for a beam of radius rb: Fcn = c st A in tension,
 // Fcs = cs st A in shear (cs = 0: c), plus mu_b Fn under compression where mu_b > 0 (PFC's
 // Mohr-Coulomb contact bond). The bond kernel and the break events' modes (bond_list.cpp) both
@@ -48,7 +51,7 @@ inline void contact_bond_strengths(const T& st, const T& rb, double c, double cs
                                    T& fcn, T& fcs) {
   const T st_area = st * (kPi * rb * rb);  // st A
   fcn = T(c) * st_area;
-  fcs = T(cs > 0 ? cs : c) * st_area;
+  fcs = T(contact_shear_factor(c, cs)) * st_area;
   if (mu_b > 0) fcs = fcs + T(mu_b) * select(fn > T(0.0), fn, T(0.0));
 }
 

@@ -21,7 +21,7 @@ BondSums bond_loop(const BondKernelArgs& k, std::size_t begin, std::size_t end) 
   const bool breakable = k.strength > 0;
   // The contact bond breaks with the beam (c = 0), never (c = inf) or at c st A (model.md 5).
   const bool with_beam = k.contact_strength == 0;
-  const double shear_factor = k.contact_shear_strength > 0 ? k.contact_shear_strength : k.contact_strength;
+  const double shear_factor = contact_shear_factor(k.contact_strength, k.contact_shear_strength);
   constexpr double never = std::numeric_limits<double>::infinity();
   const bool contact_breaks = !with_beam && (k.contact_strength < never || shear_factor < never);
   T count(0.0), slip(0.0);
