@@ -590,6 +590,124 @@ function M.cases(rows)
   return cases, table.concat(lines, "\n") .. "\n"
 end
 
+-- The fracture model against scenarios.md 4 -------------------------------------------------------
+-- Per case (surface, stress, direction) the means over seeds of its fracture runs beside its rigid
+-- and elastic runs: the peak and the residual between rigid and elastic (up to 3 % above the
+-- higher), K0 within 10 % of the elastic model's, a closure larger than the elastic model's with
+-- bonds breaking in it, at least 80 % of the broken bonds within 3 mm of the mean plane and at most
+-- 10 % of the bonds broken. The spec judges a material on the mean of 3 realisations.
+M.FRACTURE_ABOVE_HIGHER = 0.03
+M.FRACTURE_K0_TOLERANCE = 0.10
+local joint_report = require("joint.report")
+M.FRACTURE_CRITERIA = {
+  {id = "peak", text = "peak between rigid and elastic (up to 3 % above the higher)"},
+  {id = "residual", text = "residual between rigid and elastic (likewise)"},
+  {id = "k0", text = "K0 within 10 % of the elastic model's"},
+  {id = "closure", text = "closure larger than the elastic model's, bonds breaking in it"},
+  {id = "near", text = "at least 80 % of the broken bonds within 3 mm of the mean plane"},
+  {id = "broken", text = "at most 10 % of the bonds broken"},
+}
+
+function M.fracture_criteria(rows)
+  local groups, order = {}, {}
+  for _, r in ipairs(rows) do
+    if r.status == "finished" then
+      local k = key(r, "seed"):gsub("|[^|]*$", "")   -- surface|stress|direction (the model dropped)
+      groups[k] = groups[k] or {}
+      if r.model == "fracture" and not groups[k].fracture then order[#order + 1] = k end
+      groups[k][r.model] = groups[k][r.model] or {}
+      table.insert(groups[k][r.model], r)
+    end
+  end
+  local function avg(list, f)
+    local v = {}
+    for _, r in ipairs(list or {}) do if finite(r[f]) then v[#v + 1] = r[f] end end
+    return #v > 0 and (mean_sd(v)) or 0/0
+  end
+  local function between(f, rigid, elastic)
+    if not (finite(f) and finite(rigid) and finite(elastic)) then return nil end
+    local lo, hi = math.min(rigid, elastic), math.max(rigid, elastic)
+    return f >= lo and f <= (1 + M.FRACTURE_ABOVE_HIGHER) * hi
+  end
+  local cases, met_all = {}, 0
+  for _, k in ipairs(order) do
+    local g = groups[k]
+    local F, R, E = g.fracture, g.rigid, g.elastic
+    local c = {surface = F[1].surface, stress_mpa = F[1].stress_mpa, direction = F[1].direction, seeds = #F,
+               rigid_runs = R and #R or 0, elastic_runs = E and #E or 0, values = {}, met = {}}
+    local v = c.values
+    for _, f in ipairs{"peak_shear_stress_mpa", "residual_shear_stress_mpa", "initial_shear_stiffness_mpa_per_mm",
+                       "closure_mm"} do
+      v[f] = {fracture = avg(F, f), rigid = avg(R, f), elastic = avg(E, f)}
+    end
+    v.broken_bonds_in_closure = avg(F, "broken_bonds_in_closure")
+    v.broken_bonds_near_share = avg(F, "broken_bonds_near_share")
+    v.broken_bond_fraction = avg(F, "broken_bond_fraction")
+    local peak, res = v.peak_shear_stress_mpa, v.residual_shear_stress_mpa
+    local k0, cl = v.initial_shear_stiffness_mpa_per_mm, v.closure_mm
+    c.met.peak = between(peak.fracture, peak.rigid, peak.elastic)
+    c.met.residual = between(res.fracture, res.rigid, res.elastic)
+    if finite(k0.fracture) and finite(k0.elastic) then
+      c.met.k0 = math.abs(k0.fracture - k0.elastic) <= M.FRACTURE_K0_TOLERANCE * math.abs(k0.elastic)
+    end
+    if finite(cl.fracture) and finite(cl.elastic) and finite(v.broken_bonds_in_closure) then
+      c.met.closure = cl.fracture > cl.elastic and v.broken_bonds_in_closure > 0
+    end
+    if finite(v.broken_bonds_near_share) then
+      c.met.near = v.broken_bonds_near_share >= joint_report.NEAR_SHARE_MIN
+    end
+    if finite(v.broken_bond_fraction) then
+      c.met.broken = v.broken_bond_fraction <= joint_report.BROKEN_FRACTION_MAX
+    end
+    local n, judged = 0, 0
+    for _, crit in ipairs(M.FRACTURE_CRITERIA) do
+      if c.met[crit.id] ~= nil then
+        judged = judged + 1
+        if c.met[crit.id] then n = n + 1 end
+      end
+    end
+    c.criteria_met, c.criteria_judged = n, judged
+    c.meets = judged == #M.FRACTURE_CRITERIA and n == judged
+    if c.meets then met_all = met_all + 1 end
+    cases[#cases + 1] = c
+  end
+  return {cases = cases, cases_meeting_all = met_all}
+end
+
+local function fracture_markdown(FC)
+  local lines = {"", "## The fracture model against scenarios.md 4", ""}
+  if #FC.cases == 0 then
+    lines[#lines + 1] = "No finished fracture run: nothing to judge."
+    return table.concat(lines, "\n") .. "\n"
+  end
+  local few = 0
+  for _, c in ipairs(FC.cases) do if c.seeds < 3 then few = few + 1 end end
+  lines[#lines + 1] = ("Each case's fracture runs (the mean over their seeds) against its rigid and elastic runs. " ..
+                       "**%d of %d cases meet all six criteria**%s. A cell: the fracture value, then rigid .. elastic " ..
+                       "or the criterion's bound; n/a where the runs to compare with are missing."):format(
+                       FC.cases_meeting_all, #FC.cases,
+                       few > 0 and (" (the spec judges the mean of 3 realisations: %d ran fewer seeds)"):format(few) or "")
+  lines[#lines + 1] = ""
+  lines[#lines + 1] = "| case | seeds | peak MPa | residual MPa | K0 MPa/mm | closure um (breaks) | within 3 mm | broken | met |"
+  lines[#lines + 1] = "|---|---|---|---|---|---|---|---|---|"
+  local function mark(ok) return ok == nil and "n/a" or (ok and "yes" or "**no**") end
+  for _, c in ipairs(FC.cases) do
+    local v = c.values
+    local function range(t, digits)
+      local f = "%." .. digits .. "f"
+      return (f .. " (" .. f .. " .. " .. f .. ")"):format(t.fracture, t.rigid, t.elastic)
+    end
+    lines[#lines + 1] = ("| %s %g MPa %s | %d | %s %s | %s %s | %.1f (E %.1f) %s | %.1f (E %.1f; %.0f) %s | %.1f %% %s | %.1f %% %s | %d / %d |"):format(
+      c.surface, c.stress_mpa, c.direction, c.seeds,
+      range(v.peak_shear_stress_mpa, 2), mark(c.met.peak), range(v.residual_shear_stress_mpa, 2), mark(c.met.residual),
+      v.initial_shear_stiffness_mpa_per_mm.fracture, v.initial_shear_stiffness_mpa_per_mm.elastic, mark(c.met.k0),
+      1e3 * v.closure_mm.fracture, 1e3 * v.closure_mm.elastic, v.broken_bonds_in_closure, mark(c.met.closure),
+      100 * v.broken_bonds_near_share, mark(c.met.near), 100 * v.broken_bond_fraction, mark(c.met.broken),
+      c.criteria_met, c.criteria_judged)
+  end
+  return table.concat(lines, "\n") .. "\n"
+end
+
 -- Plots ------------------------------------------------------------------------------------------
 local function plots(dir, rows, curves, log)
   local pdir = dir .. "/plots"
@@ -882,17 +1000,20 @@ function M.write(o)
   local _, cases_csv = M.cases(rows)
   write_atomic(dir .. "/study_cases.csv", cases_csv)
   local T = M.trends(rows, curves)
-  write_atomic(dir .. "/trends.json", asperity.json({trends = T}))
+  local FC = M.fracture_criteria(rows)
+  write_atomic(dir .. "/trends.json", asperity.json({trends = T, fracture_criteria = FC}))
   local figures = plots(dir, rows, curves, log)
   local n = #figures
   local e, pooled = events(dir, rows, log)
   for _, f in ipairs(pooled or {}) do figures[#figures + 1] = f end
-  write_atomic(dir .. "/trends.md", trends_markdown(T, rows) .. reference_markdown(rows) .. run_time_markdown(rows, o.elapsed)
+  write_atomic(dir .. "/trends.md", trends_markdown(T, rows) .. fracture_markdown(FC) .. reference_markdown(rows)
+                                    .. run_time_markdown(rows, o.elapsed)
                                     .. figures_markdown(figures))
   local shown = 0
   for _, t in ipairs(T) do if t.verdict == "shown" then shown = shown + 1 end end
-  log("report: trends.md (%d of %d behaviours shown), %d plots in plots/, events of %d fracture runs%s",
-      shown, #T, n, e.runs, e.pooled_b and (": pooled b = %.2f +- %.2f"):format(e.pooled_b, e.pooled_b_error) or "")
+  log("report: trends.md (%d of %d behaviours shown; %d of %d cases of the fracture model meet scenarios.md 4), " ..
+      "%d plots in plots/, events of %d fracture runs%s", shown, #T, FC.cases_meeting_all, #FC.cases, n, e.runs,
+      e.pooled_b and (": pooled b = %.2f +- %.2f"):format(e.pooled_b, e.pooled_b_error) or "")
 end
 
 return M

@@ -107,6 +107,17 @@ end
 local fr = joint{surface = "S1", model = "fracture", out = out .. "/S1_fracture"}
 assert(fr.parameters.speedup == 1 and fr.mass_added == 0, "the fracture model keeps its velocity and true masses")
 assert(fr.broken_bonds > 0, "the fracture model breaks bonds")
+-- Where they broke (scenarios.md 4's damage criteria): every parallel-bond break in a depth bin,
+-- and here, in halves 3 mm thick, every one within 3 mm of the mean plane.
+do
+  local d, binned = fr.broken_bonds_by_depth_mm, 0
+  for k = 1, #d.lower do binned = binned + d.lower[k] + d.upper[k] end
+  assert(binned == fr.broken_bonds, ("%d breaks in the depth bins, %d broken bonds"):format(binned, fr.broken_bonds))
+  assert(fr.broken_bonds_near_share == 1, ("share within 3 mm %s in halves 3 mm thick"):format(fr.broken_bonds_near_share))
+  local closure_breaks = asperity.read_h5(out .. "/S1_fracture/closure.h5", "/broken_bonds")
+  assert(fr.broken_bonds_in_closure == closure_breaks[#closure_breaks] and fr.broken_bonds_in_closure <= fr.broken_bonds,
+         ("broken in the closure: %s, closure.h5 %s"):format(fr.broken_bonds_in_closure, closure_breaks[#closure_breaks]))
+end
 assert(fr.energy_shares and math.abs(fr.energy_balance_error) < 0.01,
        ("fracture: energy balance error %.3g of the input work"):format(fr.energy_balance_error))
 assert(fr.normal_stress_deviation_p95 <= 0.01, "fracture: the servo holds the normal stress")

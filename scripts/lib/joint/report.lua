@@ -28,22 +28,33 @@ local function residual_stress(run, u, tau, rows)
   return tau[rows]
 end
 
+-- The fracture model's damage criteria [scenarios.md 4]: at 5 mm of shear at least this share of
+-- the broken parallel bonds lies within NEAR_SURFACE of the mean plane, and at most this share of
+-- the halves' bonds is broken.
+M.NEAR_SURFACE_M = 3e-3
+M.NEAR_SHARE_MIN = 0.8
+M.BROKEN_FRACTION_MAX = 0.1
+
 -- Where the bonds broke [scenarios.md 4: damage near the joint surfaces, not through the halves]:
 -- depth below the mean plane (lower half) or above it (upper half, moved back by its mean
--- displacement since the genesis), 1 mm bins. Returns the bins and the broken fraction of the
--- bonds the halves held before closure, or nil without breaks outside the fracture model.
+-- displacement since the genesis), 1 mm bins. Returns the bins, the broken fraction of the bonds
+-- the halves held before closure and the share of the broken ones within M.NEAR_SURFACE_M of the
+-- mean plane (NaN without breaks), or nil without breaks outside the fracture model.
 local function broken_by_depth(run)
   local world = run.world
-  if not (world:break_count() > 0 or run.P.model == "fracture") then return nil, nil end
+  if not (world:break_count() > 0 or run.P.model == "fracture") then return nil, nil, nil end
   local shift = run:mean_height(run.upper) - run.upper_mean_z_mould
   local lower_bins, upper_bins = {}, {}
   local bins = math.max(1, math.ceil(run.P.thickness * 1e3))
   for k = 1, bins do lower_bins[k], upper_bins[k] = 0, 0 end
+  local beams, near = 0, 0
   for _, ev in ipairs(world:break_events()) do
     if ev.kind ~= "beam" then goto next end  -- the parallel bonds (the thesis's broken bonds)
     local z = ev.position[3]
     local upper_side = world:tag(ev.a) == context.UPPER
     local depth = upper_side and (z - shift) or -z
+    beams = beams + 1
+    if depth < M.NEAR_SURFACE_M then near = near + 1 end  -- an asperity's break (depth < 0) is near too
     local k = math.max(1, math.min(bins, math.floor(depth * 1e3) + 1))
     if upper_side then upper_bins[k] = upper_bins[k] + 1 else lower_bins[k] = lower_bins[k] + 1 end
     ::next::
@@ -51,7 +62,7 @@ local function broken_by_depth(run)
   local edges = {}
   for k = 1, bins do edges[k] = k end
   return {depth_mm_upper_edges = edges, lower = lower_bins, upper = upper_bins},
-         world:break_count() / math.max(1, run.bonds_at_start)
+         world:break_count() / math.max(1, run.bonds_at_start), beams > 0 and near / beams or 0/0
 end
 
 -- The plots of the curves; a failure (no gnuplot) is logged, not raised.
@@ -190,7 +201,16 @@ function M.write(run)
   local e, e0 = world:energies(), run.e0
   local input = e.boundary_work - e0.boundary_work
   local function share(v) return input ~= 0 and v / input or 0/0 end
-  local broken_depths, broken_fraction = broken_by_depth(run)
+  local broken_depths, broken_fraction, near_share = broken_by_depth(run)
+  local closure_breaks = run.closure:column("broken_bonds")[run.closure:rows()]
+  if P.model == "fracture" then
+    local function met(ok) return ok and "met" or "not met" end
+    run:log("damage after %.2f mm of shear (docs/scenarios.md 4, judged at 5 mm): %.1f %% of the bonds broken (at most %g %%: %s), "
+            .. "%.1f %% of them within %g mm of the mean plane (at least %g %%: %s); %d broke in the closure",
+            u[rows], 100 * broken_fraction, 100 * M.BROKEN_FRACTION_MAX, met(broken_fraction <= M.BROKEN_FRACTION_MAX),
+            100 * near_share, 1e3 * M.NEAR_SURFACE_M, 100 * M.NEAR_SHARE_MIN, met(near_share >= M.NEAR_SHARE_MIN),
+            closure_breaks)
+  end
   local plane_lower, cls = run.plane_lower, run.cls
   local memory = asperity.memory()
   local summary = {
@@ -243,6 +263,8 @@ function M.write(run)
     broken_bonds = world:break_count(),
     broken_bond_fraction = broken_fraction,          -- of the bonds the halves held before closure
     broken_bonds_by_depth_mm = broken_depths,        -- counts per 1 mm of depth from the mean plane
+    broken_bonds_near_share = near_share,            -- of the broken ones, the share within 3 mm of the mean plane
+    broken_bonds_in_closure = closure_breaks,
     contact_decay_exponent = q,
     max_contacts = cmax,
     dem_surface = {mean_plane_shift_m = plane_lower.shift,
