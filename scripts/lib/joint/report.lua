@@ -29,7 +29,7 @@ local function residual_stress(run, u, tau, rows)
 end
 
 -- The fracture model's damage criteria [scenarios.md 4]: at 5 mm of shear at least this share of
--- the broken parallel bonds lies within NEAR_SURFACE of the mean plane, and at most this share of
+-- the broken parallel bonds lies within NEAR_SURFACE_M of the mean plane, and at most this share of
 -- the halves' bonds is broken.
 M.NEAR_SURFACE_M = 3e-3
 M.NEAR_SHARE_MIN = 0.8
