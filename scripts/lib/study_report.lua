@@ -671,7 +671,7 @@ function M.fracture_criteria(rows)
     if c.meets then met_all = met_all + 1 end
     cases[#cases + 1] = c
   end
-  return {cases = cases, cases_meeting_all = met_all}
+  return {criteria = M.FRACTURE_CRITERIA, cases = cases, cases_meeting_all = met_all}
 end
 
 local function fracture_markdown(FC)

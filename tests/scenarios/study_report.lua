@@ -251,6 +251,7 @@ assert(images >= pngs, ("trends.md shows %d figures, plots/ holds %d"):format(im
 local tj = json.read(out .. "/trends.json")
 assert(#tj.trends == 21, ("trends.json: %d behaviours"):format(#tj.trends))
 assert(tj.fracture_criteria.cases_meeting_all == 4 and #tj.fracture_criteria.cases == 4, "trends.json: the fracture criteria")
+assert(#tj.fracture_criteria.criteria == 6 and tj.fracture_criteria.criteria[6].id == "broken", "trends.json names the criteria")
 assert(md:find("## The fracture model against scenarios.md 4", 1, true), md)
 assert(md:find("**4 of 4 cases meet all six criteria** (the spec judges the mean of 3 realisations: 4 ran fewer seeds)", 1, true), md)
 assert(md:find("| S1 14 MPa x | 2 | 12.60 (10.50 .. 13.65) yes |", 1, true), md)
