@@ -502,9 +502,11 @@ local function run_time_markdown(rows, elapsed)
     return table.concat(lines, "\n") .. "\n"
   end
   if elapsed and finite(elapsed.seconds) then
-    lines[#lines + 1] = ("The runner ran for **%s** in all (%d invocation%s, %d job%s of %d thread%s at a time; " ..
+    -- elapsed.json keeps the jobs and threads of the last invocation only
+    local several = (elapsed.invocations or 1) > 1
+    lines[#lines + 1] = ("The runner ran for **%s** in all (%d invocation%s, %s%d job%s of %d thread%s at a time; " ..
                          "the pauses between invocations not counted)."):format(duration(elapsed.seconds), elapsed.invocations or 1,
-                         (elapsed.invocations or 1) == 1 and "" or "s", elapsed.jobs or 0, elapsed.jobs == 1 and "" or "s",
+                         several and "s" or "", several and "the last " or "", elapsed.jobs or 0, elapsed.jobs == 1 and "" or "s",
                          elapsed.threads or 0, elapsed.threads == 1 and "" or "s")
   else
     lines[#lines + 1] = "The runner's elapsed time is not recorded for this folder (a Slurm study's tasks run apart; a folder " ..
