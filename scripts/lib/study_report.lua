@@ -559,7 +559,9 @@ end
 -- Mean and scatter over seeds --------------------------------------------------------------------
 local CASE_FIELDS = {"peak_shear_stress_mpa", "peak_displacement_mm", "residual_shear_stress_mpa",
                      "initial_shear_stiffness_mpa_per_mm", "max_dilatancy_mm", "normal_stiffness_mpa_per_mm",
-                     "broken_bonds", "contact_decay_exponent", "energy_shares_friction"}
+                     "broken_bonds", "contact_decay_exponent", "energy_shares_friction",
+                     -- the fracture model's criteria (M.fracture_criteria)
+                     "closure_mm", "broken_bonds_in_closure", "broken_bonds_near_share", "broken_bond_fraction"}
 function M.cases(rows)
   local groups, order = {}, {}
   for _, r in ipairs(rows) do
@@ -611,40 +613,31 @@ M.FRACTURE_CRITERIA = {
 }
 
 function M.fracture_criteria(rows)
-  local groups, order = {}, {}
-  for _, r in ipairs(rows) do
-    if r.status == "finished" then
-      local k = key(r, "seed"):gsub("|[^|]*$", "")   -- surface|stress|direction (the model dropped)
-      groups[k] = groups[k] or {}
-      if r.model == "fracture" and not groups[k].fracture then order[#order + 1] = k end
-      groups[k][r.model] = groups[k][r.model] or {}
-      table.insert(groups[k][r.model], r)
-    end
-  end
-  local function avg(list, f)
-    local v = {}
-    for _, r in ipairs(list or {}) do if finite(r[f]) then v[#v + 1] = r[f] end end
-    return #v > 0 and (mean_sd(v)) or 0/0
-  end
+  -- The means over seeds are M.cases's, per case and model.
+  local all, by_model = M.cases(rows), {}
+  for _, c in ipairs(all) do by_model[key(c, "seed")] = c end
   local function between(f, rigid, elastic)
     if not (finite(f) and finite(rigid) and finite(elastic)) then return nil end
     local lo, hi = math.min(rigid, elastic), math.max(rigid, elastic)
     return f >= lo and f <= (1 + M.FRACTURE_ABOVE_HIGHER) * hi
   end
   local cases, met_all = {}, 0
-  for _, k in ipairs(order) do
-    local g = groups[k]
-    local F, R, E = g.fracture, g.rigid, g.elastic
-    local c = {surface = F[1].surface, stress_mpa = F[1].stress_mpa, direction = F[1].direction, seeds = #F,
-               rigid_runs = R and #R or 0, elastic_runs = E and #E or 0, values = {}, met = {}}
+  for _, F in ipairs(all) do
+    if F.model ~= "fracture" then goto next end
+    local function other(model)
+      local probe = {surface = F.surface, stress_mpa = F.stress_mpa, direction = F.direction, model = model}
+      return by_model[key(probe, "seed")] or {seeds = 0}
+    end
+    local R, E = other("rigid"), other("elastic")
+    local c = {surface = F.surface, stress_mpa = F.stress_mpa, direction = F.direction, seeds = F.seeds,
+               rigid_runs = R.seeds, elastic_runs = E.seeds, values = {}, met = {}}
     local v = c.values
+    local function mean(case, f) return case[f .. "_mean"] or 0/0 end
     for _, f in ipairs{"peak_shear_stress_mpa", "residual_shear_stress_mpa", "initial_shear_stiffness_mpa_per_mm",
                        "closure_mm"} do
-      v[f] = {fracture = avg(F, f), rigid = avg(R, f), elastic = avg(E, f)}
+      v[f] = {fracture = mean(F, f), rigid = mean(R, f), elastic = mean(E, f)}
     end
-    v.broken_bonds_in_closure = avg(F, "broken_bonds_in_closure")
-    v.broken_bonds_near_share = avg(F, "broken_bonds_near_share")
-    v.broken_bond_fraction = avg(F, "broken_bond_fraction")
+    for _, f in ipairs{"broken_bonds_in_closure", "broken_bonds_near_share", "broken_bond_fraction"} do v[f] = mean(F, f) end
     local peak, res = v.peak_shear_stress_mpa, v.residual_shear_stress_mpa
     local k0, cl = v.initial_shear_stiffness_mpa_per_mm, v.closure_mm
     c.met.peak = between(peak.fracture, peak.rigid, peak.elastic)
@@ -672,6 +665,7 @@ function M.fracture_criteria(rows)
     c.meets = judged == #M.FRACTURE_CRITERIA and n == judged
     if c.meets then met_all = met_all + 1 end
     cases[#cases + 1] = c
+    ::next::
   end
   return {criteria = M.FRACTURE_CRITERIA, cases = cases, cases_meeting_all = met_all}
 end
